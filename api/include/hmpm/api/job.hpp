@@ -1,0 +1,92 @@
+// job.hpp — the job spec at the edge: JSON in, typed hmpm::Problem out, and
+// the result files out again.
+//
+// `parse_job` is the only place a job spec is read. It collects every problem
+// (not just the first), each with its JSON pointer and a message that says
+// what was expected, and converts a valid spec into the solver's typed
+// Problem with expressions compiled once (muParser). `run_job` runs a parsed
+// job and writes the contract's result files (summary.json, series.json,
+// series.csv, snapshots.pvd + .vtu) into a directory; the command line and
+// the service both use it, so their files are identical.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "hmpm/problem.hpp"
+#include "hmpm/run.hpp"
+
+namespace hmpm::api {
+
+/// One problem in a job spec: `path` is an RFC 6901 JSON pointer ("" is the
+/// whole document), `message` says what is wrong and what was expected.
+struct SpecError {
+  std::string path;
+  std::string message;
+};
+
+/// Limits that protect a shared server. Exceeding one is a SpecError whose
+/// message gives the computed figure and the limit.
+struct Limits {
+  std::int64_t max_particles = 2'000'000;
+  std::int64_t max_cells = 4'000'000;
+  std::int64_t max_steps = 20'000'000;
+  std::int64_t max_series_rows = 1'000'000;
+  std::int64_t max_snapshots = 1'000;
+  std::int64_t max_output_bytes = std::int64_t{4} << 30;  ///< estimated result size
+  std::int64_t max_body_bytes = std::int64_t{16} << 20;   ///< size of the spec text
+  int max_json_depth = 64;
+};
+
+/// What a job will cost, computed before it runs.
+struct CostEstimate {
+  std::int64_t particles = 0;
+  std::int64_t nodes = 0;
+  std::int64_t cells = 0;
+  std::int64_t steps = 0;
+  double dt = 0.0;
+  std::int64_t particle_steps = 0;
+  std::int64_t memory_bytes = 0;  ///< solver state estimate
+  std::int64_t output_bytes = 0;  ///< result files estimate
+  std::int64_t series_rows = 0;
+  std::int64_t snapshots = 0;
+};
+
+struct ParsedJob {
+  std::string name;
+  hmpm::Problem problem;
+  CostEstimate cost;
+};
+
+struct ParseResult {
+  std::optional<ParsedJob> job;   ///< set when errors is empty
+  std::vector<SpecError> errors;  ///< every problem found, in document order
+  bool ok() const { return errors.empty(); }
+};
+
+/// Parses, validates and converts a job spec. Never throws.
+ParseResult parse_job(std::string_view json_text, const Limits& limits = {});
+
+/// The result files of one run, as written into a directory.
+struct JobOutcome {
+  hmpm::RunResult run;
+  std::vector<std::string> files;  ///< names relative to the output directory
+};
+
+/// Runs `job` and writes every result file into `out_dir` (created if needed):
+/// summary.json always (also on failure), series.json and series.csv when a
+/// series was requested, snapshots.pvd and snapshot_NNNN.vtu when snapshots
+/// were requested. Throws std::runtime_error only when files cannot be written.
+JobOutcome run_job(const ParsedJob& job, const std::filesystem::path& out_dir,
+                   const hmpm::RunOptions& options = {});
+
+/// Media type of a result file by name ("application/json", "text/csv",
+/// "application/xml" for .pvd/.vtu, "application/octet-stream" otherwise).
+std::string media_type_for(std::string_view file_name);
+
+}  // namespace hmpm::api

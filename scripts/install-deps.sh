@@ -1,0 +1,38 @@
+#!/usr/bin/env bash
+# Installs the Debian packages every hmpm module, test and script needs.
+# Idempotent: runs `apt-get update` and `apt-get install` only when a package
+# is missing. Needs root (or sudo) only in that case.
+set -euo pipefail
+
+packages=(
+  build-essential cmake pkg-config git curl
+  libeigen3-dev            # solver: linear algebra (header only)
+  nlohmann-json3-dev       # api: JSON parsing
+  libmuparser-dev          # api: expressions in job specs
+  libsqlite3-dev           # server: job store
+  libcpp-httplib-dev       # server: HTTP (0.11.4, compiled library)
+  libssl-dev zlib1g-dev libbrotli-dev  # what libcpp-httplib links against
+  libgtest-dev libgmock-dev            # tests
+  libbenchmark-dev                     # bench/
+  python3                              # clients and result checks
+  python3-meshio python3-matplotlib python3-jsonschema python3-numpy
+)
+
+missing=()
+for p in "${packages[@]}"; do
+  if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
+    missing+=("$p")
+  fi
+done
+
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "install-deps: all ${#packages[@]} packages present"
+  exit 0
+fi
+
+echo "install-deps: installing ${missing[*]}"
+sudo_cmd=()
+if [ "$(id -u)" -ne 0 ]; then sudo_cmd=(sudo); fi
+export DEBIAN_FRONTEND=noninteractive
+"${sudo_cmd[@]}" apt-get update -qq
+"${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}"

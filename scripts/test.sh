@@ -1,0 +1,16 @@
+#!/usr/bin/env bash
+# One command from a fresh clone to a tested build: installs dependencies,
+# builds everything, runs every C++ test (ctest) and every Python test.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+bash scripts/install-deps.sh
+bash scripts/build.sh
+jobs=$(nproc 2>/dev/null || echo 2)
+status=0
+(cd build && ctest --output-on-failure -j "$jobs" --timeout 600) || status=1
+py=$(bash scripts/python.sh)
+if [ -d tests/python ] && ls tests/python/test_*.py >/dev/null 2>&1; then
+  HMPM_BUILD_DIR="$PWD/build" PYTHONPATH="$PWD/clients/python" \
+    "$py" -m unittest discover -s tests/python -t . -v || status=1
+fi
+exit $status

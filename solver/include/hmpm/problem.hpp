@@ -1,0 +1,185 @@
+// problem.hpp — the typed description of an hmpm simulation.
+//
+// This is what the solver consumes: a structured background grid, materials,
+// bodies filled with particles, boundary conditions, loads, time control and
+// output requests. It is built once (by the api module from a JSON job spec,
+// or directly by tests and benchmarks) and never looked up by string
+// afterwards. All quantities are SI: metres, seconds, kilograms, pascals.
+//
+// Functions of position (initial fields) are evaluated once per particle at
+// set-up; functions of time (boundary values, tractions) once per time step,
+// never per particle.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <limits>
+#include <optional>
+#include <string>
+#include <variant>
+#include <vector>
+
+namespace hmpm {
+
+/// A point or vector with up to three components; unused trailing components
+/// are zero in 1D and 2D.
+using Vec3 = std::array<double, 3>;
+
+/// A value that may depend on position (x, y, z) — initial fields.
+/// An empty function means "zero".
+using FieldOfPosition = std::function<double(const Vec3& x)>;
+
+/// A value that may depend on time t in seconds — boundary values and loads.
+/// An empty function means "zero".
+using FieldOfTime = std::function<double(double t)>;
+
+/// Axis-aligned box [min, max] (closed). Components beyond the dimension are ignored.
+struct Box {
+  Vec3 min{0.0, 0.0, 0.0};
+  Vec3 max{0.0, 0.0, 0.0};
+};
+
+/// Structured background grid; cell size per axis = (max - min) / cells.
+struct Grid {
+  Vec3 min{0.0, 0.0, 0.0};
+  Vec3 max{1.0, 1.0, 1.0};
+  std::array<int, 3> cells{1, 1, 1};
+};
+
+enum class ShapeFunction { linear, gimp, bspline };
+
+/// Hydraulic properties: their presence makes a material a saturated porous
+/// medium solved with the u-p formulation.
+struct Hydraulic {
+  double porosity = 0.3;                 ///< n, in (0, 1)
+  double hydraulic_conductivity = 1e-3;  ///< k in m/s (Darcy's "permeability" of the paper)
+  double fluid_bulk_modulus = 2.2e9;     ///< Kf in Pa
+  double fluid_density = 1000.0;         ///< rho_f in kg/m^3
+  /// Ks in Pa; infinity means incompressible grains.
+  double solid_bulk_modulus = std::numeric_limits<double>::infinity();
+};
+
+struct LinearElastic {};
+
+/// Mohr-Coulomb, non-associated, with tension cut-off. Angles in degrees.
+struct MohrCoulomb {
+  double friction_angle_deg = 30.0;
+  double dilatancy_angle_deg = 0.0;
+  double cohesion = 0.0;  ///< Pa
+  double tensile_strength = 0.0;  ///< Pa; cut-off on the major principal stress
+};
+
+/// Drucker-Prager fitted to Mohr-Coulomb (plane-strain match). Angles in degrees.
+struct DruckerPrager {
+  double friction_angle_deg = 30.0;
+  double dilatancy_angle_deg = 0.0;
+  double cohesion = 0.0;
+  double tensile_strength = 0.0;
+};
+
+using Plasticity = std::variant<LinearElastic, MohrCoulomb, DruckerPrager>;
+
+struct Material {
+  std::string name;  ///< for messages only
+  /// Bulk density (dry material) or grain density rho_s (with hydraulic).
+  double density = 1.0;
+  double youngs_modulus = 1.0;
+  double poisson_ratio = 0.0;
+  Plasticity plasticity = LinearElastic{};
+  std::optional<Hydraulic> hydraulic;
+};
+
+/// Initial fields of a body; each entry is a function of the particle's
+/// initial position. Empty functions mean zero.
+struct InitialFields {
+  std::array<FieldOfPosition, 3> velocity;
+  FieldOfPosition pore_pressure;
+  /// Voigt order: xx, yy, zz, xy, yz, zx. Compression negative.
+  std::array<FieldOfPosition, 6> effective_stress;
+};
+
+/// A box filled with `particles_per_cell` particles per axis per cell, at
+/// sub-cell centres, of cells of the grid that lie inside the box.
+struct Body {
+  int material = 0;  ///< index into Problem::materials
+  Box box;
+  int particles_per_cell = 2;
+  InitialFields initial;
+};
+
+/// Grid nodes a boundary condition applies to.
+struct NodeSelection {
+  bool all = false;
+  Box box;  ///< closed box; used when !all
+};
+
+/// Prescribed nodal velocity components and/or pore pressure.
+struct Boundary {
+  NodeSelection nodes;
+  /// One entry per axis; std::nullopt leaves that component free.
+  std::array<std::optional<FieldOfTime>, 3> velocity;
+  bool has_velocity = false;  ///< any velocity component prescribed
+  std::optional<FieldOfTime> pore_pressure;
+};
+
+/// Surface load on one face of the particles inside `particles`.
+/// Force = traction * (particle volume / its initial length along the face normal).
+struct Traction {
+  Box particles;
+  int axis = 0;   ///< face normal axis: 0 = x, 1 = y, 2 = z
+  int side = +1;  ///< +1 for "x+", -1 for "x-"
+  std::array<FieldOfTime, 3> traction;  ///< Pa, per axis
+};
+
+struct TimeControl {
+  double end = 1.0;           ///< s, required
+  std::optional<double> dt;   ///< s; absent: automatic
+  double courant = 0.5;       ///< factor on the stable step when dt is automatic
+};
+
+enum class Field : std::uint8_t {
+  position,
+  displacement,
+  velocity,
+  pore_pressure,
+  darcy_velocity,
+  effective_stress,
+  strain,
+  porosity,
+  total_stress,
+};
+inline constexpr int field_count = 9;
+
+/// Number of components a field has in `dim` dimensions (vectors: dim;
+/// tensors: 6 in Voigt order xx, yy, zz, xy, yz, zx; scalars: 1).
+int field_components(Field f, int dim);
+/// The contract's name of a field ("pore_pressure", ...).
+const char* field_name(Field f);
+
+struct OutputRequest {
+  std::vector<std::int64_t> series_particles;  ///< global particle indices
+  std::vector<Field> series_fields;
+  double series_interval = 0.0;  ///< s; <= 0: every step
+  std::vector<Field> snapshot_fields;  ///< empty: all fields
+  double snapshot_interval = 0.0;  ///< s; <= 0: no snapshots
+};
+
+struct Problem {
+  int dimension = 1;  ///< 1 (uniaxial strain), 2 (plane strain) or 3
+  Grid grid;
+  ShapeFunction shape_function = ShapeFunction::linear;
+  std::vector<Material> materials;
+  std::vector<Body> bodies;
+  Vec3 gravity{0.0, 0.0, 0.0};  ///< m/s^2
+  std::vector<Boundary> boundaries;
+  std::vector<Traction> tractions;
+  TimeControl time;
+  OutputRequest output;
+  /// Acceleration of gravity used for the unit weight of water gamma_w = rho_f * g.
+  double gravity_constant = 9.81;
+  /// Local (Cundall) damping coefficient in [0, 1); 0 = none.
+  double local_damping = 0.0;
+};
+
+}  // namespace hmpm

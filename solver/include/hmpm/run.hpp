@@ -1,0 +1,135 @@
+// run.hpp — running a Problem: set-up checks, the time loop, and what comes out.
+//
+// `run()` is the one entry point: it fills the bodies with particles, picks
+// or checks the time step, advances the explicit u-p MPM cycle to the end
+// time, samples the requested outputs, reports progress and honours
+// cooperative cancellation. It never throws for a physical failure: a run
+// that diverges, loses a particle or inverts a volume ends with
+// `RunStatus::failed` and a message naming the step, time, particle and what
+// to change. It throws `std::invalid_argument` only for a Problem that
+// `check_problem` would have rejected.
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "hmpm/problem.hpp"
+
+namespace hmpm {
+
+/// A problem found in a Problem before running. `where` names the part in
+/// the vocabulary of the job spec (e.g. "time/dt", "bodies/0/box"), so the
+/// api can turn it into a JSON pointer.
+struct ProblemIssue {
+  std::string where;
+  std::string message;
+};
+
+/// Stable time step estimate, in seconds.
+struct StableStep {
+  double mechanical = 0.0;  ///< h_min / c, c the undrained P-wave speed
+  double hydraulic = 0.0;   ///< explicit diffusion limit h^2 / (2 d c_h); inf if dry
+  double limit = 0.0;       ///< min of the two (Courant factor 1)
+  double chosen = 0.0;      ///< the dt the run will use
+  double wave_speed = 0.0;  ///< m/s, fastest material
+};
+
+/// Estimates the stable step for `problem` (automatic or user dt).
+StableStep stable_step(const Problem& problem);
+
+/// Checks a Problem for anything the solver cannot run: dimensions,
+/// positive moduli and densities, boxes inside the grid, a user dt above the
+/// stable limit (refused, with the limit in the message), empty bodies.
+/// Returns every issue found; empty means runnable.
+std::vector<ProblemIssue> check_problem(const Problem& problem);
+
+/// Number of particles the bodies generate (cheap; no allocation per particle).
+std::int64_t count_particles(const Problem& problem);
+
+/// Initial positions of every particle, in the global numbering of the
+/// contract (bodies in order; in a body x fastest, then y, then z).
+std::vector<Vec3> initial_positions(const Problem& problem);
+
+/// Index of the particle whose initial position is nearest to `x`; -1 if none.
+std::int64_t nearest_particle(const Problem& problem, const Vec3& x);
+
+struct Progress {
+  std::int64_t step = 0;
+  std::int64_t total_steps = 0;
+  double time = 0.0;      ///< simulated time, s
+  double end_time = 0.0;  ///< s
+  double fraction = 0.0;  ///< time / end_time in [0, 1]
+};
+
+/// All particles' fields at one instant, for snapshot writers. Arrays are
+/// flat: entry i of a vector field with c components is [i*c, i*c + c).
+/// Vectors always have 3 components (zero-padded), tensors 6 (Voigt).
+struct Snapshot {
+  int index = 0;  ///< 0, 1, 2, ... in time order
+  double time = 0.0;
+  int dimension = 1;
+  std::int64_t particles = 0;
+  std::vector<Field> fields;          ///< which of the arrays below are filled
+  std::vector<double> position;       ///< 3 per particle
+  std::vector<double> displacement;   ///< 3
+  std::vector<double> velocity;       ///< 3
+  std::vector<double> pore_pressure;  ///< 1
+  std::vector<double> darcy_velocity; ///< 3
+  std::vector<double> effective_stress;  ///< 6
+  std::vector<double> total_stress;   ///< 6
+  std::vector<double> strain;         ///< 6
+  std::vector<double> porosity;       ///< 1
+  std::vector<double> volume;         ///< 1, always filled
+  std::vector<int> material;          ///< 1, always filled
+};
+
+/// Time histories of the selected particles. `values[f]` holds, for field
+/// `fields[f]`, rows in time order; each row is particles x components
+/// (components from field_components(fields[f], dimension)).
+struct Series {
+  int dimension = 1;
+  std::vector<double> time;
+  std::vector<std::int64_t> particles;
+  std::vector<Vec3> initial_positions;
+  std::vector<Field> fields;
+  std::vector<std::vector<double>> values;
+};
+
+struct RunOptions {
+  int threads = 1;  ///< solver threads; <= 0 means every core
+  /// Called about every `progress_interval_s` seconds of wall time, and once at the end.
+  std::function<void(const Progress&)> on_progress;
+  double progress_interval_s = 0.5;
+  /// Called for every snapshot as it is taken (written by the caller, not kept).
+  std::function<void(const Snapshot&)> on_snapshot;
+  /// Checked once per step; when it becomes true the run stops as cancelled.
+  const std::atomic<bool>* cancel = nullptr;
+  /// Wall-clock limit on the time loop in seconds; <= 0: none.
+  double wall_time_limit_s = 0.0;
+};
+
+enum class RunStatus { successful, failed, cancelled };
+const char* status_name(RunStatus s);
+
+struct RunResult {
+  RunStatus status = RunStatus::failed;
+  std::string message;
+  std::vector<std::string> warnings;
+  std::int64_t steps = 0;
+  double end_time = 0.0;  ///< simulated time reached, s
+  double dt = 0.0;
+  std::int64_t particles = 0;
+  std::int64_t nodes = 0;
+  double solve_seconds = 0.0;  ///< wall time of the time loop only
+  double particle_steps_per_second = 0.0;
+  std::int64_t state_bytes = 0;  ///< particle + grid state in memory
+  Series series;
+};
+
+/// Runs `problem` to its end time. See the file comment for failure modes.
+RunResult run(const Problem& problem, const RunOptions& options = {});
+
+}  // namespace hmpm

@@ -1,0 +1,243 @@
+// problem.cpp — everything about a Problem that is not the time loop:
+// particle generation and numbering, the stable time step, and the checks
+// that decide whether a Problem can run at all.
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+
+#include "hmpm/problem.hpp"
+#include "hmpm/run.hpp"
+#include "materials.hpp"
+#include "particle_layout.hpp"
+
+namespace hmpm {
+
+int field_components(Field f, int dim) {
+  switch (f) {
+    case Field::position:
+    case Field::displacement:
+    case Field::velocity:
+    case Field::darcy_velocity:
+      return dim;
+    case Field::effective_stress:
+    case Field::total_stress:
+    case Field::strain:
+      return 6;
+    case Field::pore_pressure:
+    case Field::porosity:
+      return 1;
+  }
+  return 1;
+}
+
+const char* field_name(Field f) {
+  switch (f) {
+    case Field::position: return "position";
+    case Field::displacement: return "displacement";
+    case Field::velocity: return "velocity";
+    case Field::pore_pressure: return "pore_pressure";
+    case Field::darcy_velocity: return "darcy_velocity";
+    case Field::effective_stress: return "effective_stress";
+    case Field::strain: return "strain";
+    case Field::porosity: return "porosity";
+    case Field::total_stress: return "total_stress";
+  }
+  return "?";
+}
+
+const char* status_name(RunStatus s) {
+  switch (s) {
+    case RunStatus::successful: return "successful";
+    case RunStatus::failed: return "failed";
+    case RunStatus::cancelled: return "dismissed";
+  }
+  return "failed";
+}
+
+// ---------------------------------------------------------------- layout
+
+BodyLayout body_layout(const Problem& problem, const Body& body) {
+  BodyLayout layout;
+  const int ppc = std::max(body.particles_per_cell, 1);
+  for (int a = 0; a < 3; ++a) {
+    layout.coords[a].clear();
+    if (a >= problem.dimension) {
+      layout.coords[a].push_back(0.0);
+      continue;
+    }
+    const double h = (problem.grid.max[a] - problem.grid.min[a]) / problem.grid.cells[a];
+    const double tol = 1e-9 * h;
+    for (int c = 0; c < problem.grid.cells[a]; ++c) {
+      const double lo = problem.grid.min[a] + c * h;
+      const double hi = lo + h;
+      if (lo < body.box.min[a] - tol || hi > body.box.max[a] + tol) continue;
+      for (int k = 0; k < ppc; ++k) layout.coords[a].push_back(lo + (k + 0.5) * h / ppc);
+    }
+  }
+  layout.count = static_cast<std::int64_t>(layout.coords[0].size()) *
+                 static_cast<std::int64_t>(layout.coords[1].size()) *
+                 static_cast<std::int64_t>(layout.coords[2].size());
+  return layout;
+}
+
+std::int64_t count_particles(const Problem& problem) {
+  std::int64_t n = 0;
+  for (const Body& b : problem.bodies) n += body_layout(problem, b).count;
+  return n;
+}
+
+std::vector<Vec3> initial_positions(const Problem& problem) {
+  std::vector<Vec3> out;
+  out.reserve(static_cast<std::size_t>(count_particles(problem)));
+  for (const Body& b : problem.bodies) {
+    const BodyLayout layout = body_layout(problem, b);
+    for (double z : layout.coords[2])
+      for (double y : layout.coords[1])
+        for (double x : layout.coords[0]) out.push_back({x, y, z});
+  }
+  return out;
+}
+
+std::int64_t nearest_particle(const Problem& problem, const Vec3& x) {
+  std::int64_t best = -1;
+  double best_d2 = std::numeric_limits<double>::infinity();
+  std::int64_t index = 0;
+  for (const Body& b : problem.bodies) {
+    const BodyLayout layout = body_layout(problem, b);
+    for (double pz : layout.coords[2])
+      for (double py : layout.coords[1])
+        for (double px : layout.coords[0]) {
+          const double d2 = (px - x[0]) * (px - x[0]) + (py - x[1]) * (py - x[1]) +
+                            (pz - x[2]) * (pz - x[2]);
+          if (d2 < best_d2) {
+            best_d2 = d2;
+            best = index;
+          }
+          ++index;
+        }
+  }
+  return best;
+}
+
+// ---------------------------------------------------------------- time step
+
+double min_cell_size(const Problem& problem) {
+  double h = std::numeric_limits<double>::infinity();
+  for (int a = 0; a < problem.dimension; ++a)
+    h = std::min(h, (problem.grid.max[a] - problem.grid.min[a]) / problem.grid.cells[a]);
+  return h;
+}
+
+StableStep stable_step(const Problem& problem) {
+  StableStep s;
+  const double h = min_cell_size(problem);
+  const double d = problem.dimension;
+  s.mechanical = std::numeric_limits<double>::infinity();
+  s.hydraulic = std::numeric_limits<double>::infinity();
+  for (const Material& m : problem.materials) {
+    const MaterialConstants mc = material_constants(m, problem.gravity_constant);
+    const double c = std::sqrt(mc.undrained_p_modulus / mc.mixture_density);
+    s.wave_speed = std::max(s.wave_speed, c);
+    // Explicit central differences with lumped mass: omega_max <= sqrt(d) 2c/h,
+    // stable for dt <= 2/omega_max = h / (c sqrt(d)).
+    s.mechanical = std::min(s.mechanical, h / (c * std::sqrt(d)));
+    if (m.hydraulic) {
+      // Forward Euler on dp/dt = c_h lap p with lumped storage:
+      // lambda_max = 4 d c_h / h^2, stable for dt <= 2/lambda_max.
+      const double c_h = mc.permeability_over_gamma / mc.storage;
+      s.hydraulic = std::min(s.hydraulic, h * h / (2.0 * d * c_h));
+    }
+  }
+  s.limit = std::min(s.mechanical, s.hydraulic);
+  s.chosen = problem.time.dt ? *problem.time.dt : problem.time.courant * s.limit;
+  return s;
+}
+
+// ---------------------------------------------------------------- checks
+
+namespace {
+
+std::string fmt(double v) {
+  std::ostringstream o;
+  o.precision(4);
+  o << v;
+  return o.str();
+}
+
+}  // namespace
+
+std::vector<ProblemIssue> check_problem(const Problem& problem) {
+  std::vector<ProblemIssue> issues;
+  auto add = [&](std::string where, std::string msg) {
+    issues.push_back({std::move(where), std::move(msg)});
+  };
+  const int dim = problem.dimension;
+  if (dim < 1 || dim > 3) {
+    add("dimension", "must be 1, 2 or 3");
+    return issues;
+  }
+  for (int a = 0; a < dim; ++a) {
+    if (problem.grid.cells[a] < 1)
+      add("grid/cells/" + std::to_string(a), "must be >= 1");
+    if (!(problem.grid.max[a] > problem.grid.min[a]))
+      add("grid/max/" + std::to_string(a), "must be greater than grid.min");
+  }
+  if (!issues.empty()) return issues;
+
+  for (std::size_t i = 0; i < problem.materials.size(); ++i) {
+    const Material& m = problem.materials[i];
+    const std::string w = "materials/" + m.name + "/";
+    if (!(m.density > 0)) add(w + "density", "must be > 0");
+    if (!(m.youngs_modulus > 0)) add(w + "youngs_modulus", "must be > 0");
+    if (!(m.poisson_ratio > -1.0 && m.poisson_ratio < 0.5))
+      add(w + "poisson_ratio", "must be in (-1, 0.5)");
+    if (m.hydraulic) {
+      const Hydraulic& hy = *m.hydraulic;
+      if (!(hy.porosity > 0 && hy.porosity < 1)) add(w + "hydraulic/porosity", "must be in (0, 1)");
+      if (!(hy.hydraulic_conductivity >= 0))
+        add(w + "hydraulic/hydraulic_conductivity", "must be >= 0");
+      if (!(hy.fluid_bulk_modulus > 0)) add(w + "hydraulic/fluid_bulk_modulus", "must be > 0");
+      if (!(hy.fluid_density > 0)) add(w + "hydraulic/fluid_density", "must be > 0");
+      if (!(hy.solid_bulk_modulus > 0)) add(w + "hydraulic/solid_bulk_modulus", "must be > 0");
+    }
+  }
+  if (problem.bodies.empty()) add("bodies", "at least one body is needed");
+  for (std::size_t b = 0; b < problem.bodies.size(); ++b) {
+    const Body& body = problem.bodies[b];
+    const std::string w = "bodies/" + std::to_string(b) + "/";
+    if (body.material < 0 || body.material >= static_cast<int>(problem.materials.size()))
+      add(w + "material", "names no material");
+    if (body.particles_per_cell < 1) add(w + "particles_per_cell", "must be >= 1");
+    else if (body_layout(problem, body).count == 0)
+      add(w + "box", "contains no whole grid cell, so no particles; a body fills the cells "
+                     "that lie entirely inside its box");
+  }
+  if (!(problem.time.end > 0)) add("time/end", "must be > 0");
+  if (!(problem.time.courant > 0 && problem.time.courant <= 1)) add("time/courant", "must be in (0, 1]");
+  if (problem.time.dt && !(*problem.time.dt > 0)) add("time/dt", "must be > 0");
+  if (!issues.empty()) return issues;
+
+  const StableStep s = stable_step(problem);
+  if (problem.time.dt && *problem.time.dt > s.limit * (1.0 + 1e-12)) {
+    std::string why = s.hydraulic < s.mechanical
+                          ? "the explicit hydraulic diffusion limit h^2/(2 d k/(gamma_w Q))"
+                          : "the mechanical limit h/(c sqrt(d)) with undrained wave speed c = " +
+                                fmt(s.wave_speed) + " m/s";
+    add("time/dt", "is " + fmt(*problem.time.dt) + " s, above the stable limit " + fmt(s.limit) +
+                       " s (" + why + "); use dt <= " + fmt(s.limit) +
+                       " or omit dt to let the solver choose " + fmt(0.5 * s.limit) + " s");
+  }
+  const std::int64_t n = count_particles(problem);
+  for (std::size_t i = 0; i < problem.output.series_particles.size(); ++i) {
+    const std::int64_t p = problem.output.series_particles[i];
+    if (p < 0 || p >= n)
+      add("output/series/particles/" + std::to_string(i),
+          "particle " + std::to_string(p) + " does not exist; there are " + std::to_string(n) +
+              " particles (0.." + std::to_string(n - 1) + ")");
+  }
+  return issues;
+}
+
+}  // namespace hmpm
