@@ -83,6 +83,7 @@ struct Snapshot {
   std::vector<double> strain;         ///< 6
   std::vector<double> porosity;       ///< 1
   std::vector<double> volume;         ///< 1, always filled
+  std::vector<double> mass;           ///< 1, always filled
   std::vector<int> material;          ///< 1, always filled
 };
 

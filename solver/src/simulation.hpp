@@ -1,0 +1,563 @@
+// simulation.hpp — the explicit u-p MPM time step (internal).
+//
+// One Simulation<Dim, Shape> owns the particle and grid state of a run and
+// advances it with the momentum-based MUSL cycle of the seed paper (§3.4),
+// extended with the fluid mass balance of the u-p formulation:
+//
+//   mixture momentum   rho a = div(sigma' - p I) + rho b
+//   fluid mass balance Q dp/dt = -div v - div w,   Q = (1-n)/Ks + n/Kf
+//   Darcy              w = -k/(rho_f g) (grad p - rho_f b + rho_f a)
+//
+// Pore pressure lives on the grid during a step. Particles carry it from step
+// to step as a transported state updated with nodal increments (FLIP), and
+// report the value interpolated from the nodal field. Because everything the
+// equations see is the nodal field, the particle-level checkerboard mode of
+// one-particle-per-cell layouts cannot enter the solution, and the linear
+// steady state is reproduced exactly at every particle. The Darcy term
+// rho_f a uses the nodal acceleration of the same step, interpolated to the
+// particle (see docs/verification.md for why this is stable).
+//
+// The step reads as named phases (see `step`). No phase allocates, calls a
+// virtual function or looks anything up by string.
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/LU>
+#include <algorithm>
+#include <array>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "hmpm/problem.hpp"
+#include "hmpm/run.hpp"
+#include "materials.hpp"
+#include "particle_layout.hpp"
+#include "shape.hpp"
+#include "state.hpp"
+
+namespace hmpm {
+
+template <int Dim, class Shape>
+class Simulation {
+ public:
+  using Vec = VecD<Dim>;
+  using Mat = Eigen::Matrix<double, Dim, Dim>;
+  using StencilT = shape::Stencil<Dim, Shape>;
+
+  explicit Simulation(const Problem& problem) : problem_(problem) {
+    setup_grid();
+    setup_materials();
+    setup_particles();
+    setup_boundaries();
+    setup_tractions();
+  }
+
+  RunResult run(const RunOptions& options);
+
+ private:
+  // ------------------------------------------------------------ set-up
+  void setup_grid() {
+    for (int a = 0; a < Dim; ++a) {
+      grid_.cells[a] = problem_.grid.cells[a];
+      grid_.origin[a] = problem_.grid.min[a];
+      grid_.h[a] = (problem_.grid.max[a] - problem_.grid.min[a]) / grid_.cells[a];
+      grid_.inv_h[a] = 1.0 / grid_.h[a];
+    }
+    grid_.count = 1;
+    for (int a = 0; a < Dim; ++a) {
+      grid_.stride[a] = grid_.count;
+      grid_.count *= grid_.cells[a] + 1;
+    }
+  }
+
+  void setup_materials() {
+    for (const Material& m : problem_.materials) {
+      constants_.push_back(material_constants(m, problem_.gravity_constant));
+      const Hydraulic h = m.hydraulic.value_or(Hydraulic{});
+      inv_ks_.push_back(std::isinf(h.solid_bulk_modulus) ? 0.0 : 1.0 / h.solid_bulk_modulus);
+      inv_kf_.push_back(1.0 / h.fluid_bulk_modulus);
+      fluid_ = fluid_ || m.hydraulic.has_value();
+    }
+    for (int a = 0; a < Dim; ++a) gravity_[a] = problem_.gravity[a];
+  }
+
+  void setup_particles() {
+    const bool gimp = std::is_same_v<Shape, shape::Gimp>;
+    particles_.resize(static_cast<std::size_t>(count_particles(problem_)), fluid_, gimp);
+    grid_.resize(fluid_);
+    std::size_t p = 0;
+    double cell_volume = 1.0;
+    for (int a = 0; a < Dim; ++a) cell_volume *= grid_.h[a];
+    for (const Body& body : problem_.bodies) {
+      const BodyLayout layout = body_layout(problem_, body);
+      const MaterialConstants& mc = constants_[static_cast<std::size_t>(body.material)];
+      const int ppc = body.particles_per_cell;
+      const double v0 = cell_volume / std::pow(ppc, Dim);
+      for (double z : layout.coords[2])
+        for (double y : layout.coords[1])
+          for (double x : layout.coords[0]) {
+            const Vec3 x3{x, y, z};
+            for (int a = 0; a < Dim; ++a) particles_.x[p][a] = x3[a];
+            particles_.volume[p] = v0;
+            particles_.mass[p] = mc.mixture_density * v0;
+            particles_.material[p] = static_cast<std::uint16_t>(body.material);
+            if (gimp) particles_.half_length[p] = 0.5 / ppc;
+            const InitialFields& init = body.initial;
+            for (int a = 0; a < Dim; ++a)
+              if (init.velocity[a]) particles_.v[p][a] = init.velocity[a](x3);
+            for (int c = 0; c < 6; ++c)
+              if (init.effective_stress[c]) particles_.stress[p][c] = init.effective_stress[c](x3);
+            if (fluid_ && mc.saturated) {
+              const double p0 = init.pore_pressure ? init.pore_pressure(x3) : 0.0;
+              particles_.pressure[p] = p0;
+              particles_.pressure_out[p] = p0;
+              particles_.porosity[p] = mc.porosity;
+            }
+            ++p;
+          }
+    }
+  }
+
+  bool node_in_box(std::int64_t i, const Box& box) const {
+    const Vec xn = grid_.node_position(i);
+    for (int a = 0; a < Dim; ++a) {
+      const double tol = 1e-9 * grid_.h[a];
+      if (xn[a] < box.min[a] - tol || xn[a] > box.max[a] + tol) return false;
+    }
+    return true;
+  }
+
+  void setup_boundaries() {
+    for (const Boundary& b : problem_.boundaries) {
+      std::vector<std::int64_t> nodes;
+      for (std::int64_t i = 0; i < grid_.count; ++i)
+        if (b.nodes.all || node_in_box(i, b.nodes.box)) nodes.push_back(i);
+      if (b.has_velocity) {
+        VelocityConstraint vc;
+        vc.nodes = nodes;
+        for (int a = 0; a < Dim; ++a)
+          if (b.velocity[a]) {
+            vc.fixed[a] = true;
+            vc.fn[a] = &*b.velocity[a];
+          }
+        velocity_bcs_.push_back(std::move(vc));
+      }
+      if (b.pore_pressure && fluid_) pressure_bcs_.push_back({std::move(nodes), &*b.pore_pressure});
+    }
+  }
+
+  void setup_tractions() {
+    const std::vector<Vec3> x0 = initial_positions(problem_);
+    for (const Traction& t : problem_.tractions) {
+      TractionLoad load;
+      load.source = &t;
+      load.axis = t.axis;
+      load.side = t.side;
+      for (std::size_t p = 0; p < x0.size(); ++p) {
+        bool inside = true;
+        for (int a = 0; a < Dim; ++a)
+          inside = inside && x0[p][a] >= t.particles.min[a] - 1e-12 &&
+                   x0[p][a] <= t.particles.max[a] + 1e-12;
+        if (!inside) continue;
+        load.particles.push_back(static_cast<std::int64_t>(p));
+        // Initial length along the face normal: the cell size over the body's
+        // particles per cell, recovered from the initial volume per axis.
+        load.length0.push_back(std::pow(particles_.volume[p], 1.0 / Dim));
+        load.volume0.push_back(particles_.volume[p]);
+      }
+      tractions_.push_back(std::move(load));
+    }
+    // Particles of a body are not cubes when cells are not; use the cell size
+    // along the normal over particles per cell when available.
+    for (TractionLoad& load : tractions_)
+      for (std::size_t k = 0; k < load.particles.size(); ++k) {
+        const auto p = static_cast<std::size_t>(load.particles[k]);
+        double ppc_volume = 1.0;
+        for (int a = 0; a < Dim; ++a) ppc_volume *= grid_.h[a];
+        const double n_per_axis = std::round(std::pow(ppc_volume / particles_.volume[p], 1.0 / Dim));
+        load.length0[k] = grid_.h[load.axis] / std::max(n_per_axis, 1.0);
+      }
+  }
+
+  // ------------------------------------------------------------ the step
+  /// Advances the state from t to t + dt. Sets failure_ on the first problem.
+  void step(double t, double dt) {
+    clear_grid();
+    map_particles_to_grid();
+    if (fluid_) {
+      compute_nodal_pressure(t);
+      map_pore_pressure_force();
+    }
+    apply_tractions(t);
+    update_nodal_momentum(t, dt);
+    update_particle_velocities_and_remap(dt);
+    compute_remapped_nodal_velocity(t + dt);
+    if (fluid_) {
+      update_particle_stress_and_fluid_flux</*Move=*/false>(dt);
+      update_nodal_pressure(t + dt, dt);
+      update_particle_pressure_and_position(dt);
+    } else {
+      update_particle_stress_and_fluid_flux</*Move=*/true>(dt);
+    }
+  }
+
+  inline void stencil_of(std::size_t p, StencilT& s) const {
+    s.compute(particles_.x[p], grid_.origin, grid_.inv_h, grid_.cells, grid_.stride,
+              particles_.half_length.empty() ? 0.0 : particles_.half_length[p]);
+  }
+
+  void clear_grid() {
+    std::fill(grid_.mass.begin(), grid_.mass.end(), 0.0);
+    std::fill(grid_.momentum.begin(), grid_.momentum.end(), Vec::Zero());
+    std::fill(grid_.force.begin(), grid_.force.end(), Vec::Zero());
+    std::fill(grid_.remap.begin(), grid_.remap.end(), Vec::Zero());
+    if (fluid_) {
+      std::fill(grid_.storage.begin(), grid_.storage.end(), 0.0);
+      std::fill(grid_.pressure.begin(), grid_.pressure.end(), 0.0);
+      std::fill(grid_.flux.begin(), grid_.flux.end(), 0.0);
+    }
+  }
+
+  /// Total stress divergence term of one particle: f_i -= V sigma grad N_i,
+  /// with sigma the (3D) effective stress restricted to the active axes.
+  static inline Mat active_stress(const Voigt& s) {
+    Mat m;
+    if constexpr (Dim == 1) {
+      m(0, 0) = s[0];
+    } else if constexpr (Dim == 2) {
+      m << s[0], s[3], s[3], s[1];
+    } else {
+      m << s[0], s[3], s[5], s[3], s[1], s[4], s[5], s[4], s[2];
+    }
+    return m;
+  }
+
+  /// Phase 1: mass, momentum, effective-stress and body forces, and the
+  /// fluid storage and storage-weighted pressure, from particles to nodes.
+  void map_particles_to_grid() {
+    StencilT s;
+    for (std::size_t p = 0; p < particles_.size(); ++p) {
+      stencil_of(p, s);
+      const double m = particles_.mass[p];
+      const double vol = particles_.volume[p];
+      const Vec mv = m * particles_.v[p];
+      const Vec mb = m * gravity_;
+      const Mat sig = active_stress(particles_.stress[p]);
+      for (int k = 0; k < StencilT::N; ++k) {
+        const std::int64_t i = s.node[k];
+        const double w = s.w[k];
+        const Eigen::Map<const Vec> g(s.grad[k].data());
+        grid_.mass[i] += w * m;
+        grid_.momentum[i] += w * mv;
+        grid_.force[i] += w * mb - vol * (sig * g);
+      }
+      if (fluid_) {
+        const std::uint16_t mat = particles_.material[p];
+        if (!constants_[mat].saturated) continue;
+        const double n = particles_.porosity[p];
+        const double qv = ((1.0 - n) * inv_ks_[mat] + n * inv_kf_[mat]) * vol;
+        const double qvp = qv * particles_.pressure[p];
+        for (int k = 0; k < StencilT::N; ++k) {
+          grid_.storage[s.node[k]] += s.w[k] * qv;
+          grid_.pressure[s.node[k]] += s.w[k] * qvp;
+        }
+      }
+    }
+  }
+
+  /// Nodal pressure = storage-weighted average of particle pressures, then
+  /// prescribed values at time t.
+  void compute_nodal_pressure(double t) {
+    for (std::int64_t i = 0; i < grid_.count; ++i)
+      grid_.pressure[i] = grid_.storage[i] > 0 ? grid_.pressure[i] / grid_.storage[i] : 0.0;
+    for (const PressureConstraint& bc : pressure_bcs_) {
+      const double value = (*bc.fn)(t);
+      for (std::int64_t i : bc.nodes) grid_.pressure[i] = value;
+    }
+  }
+
+  /// Phase 2 (saturated): the pore pressure interpolated from the nodes,
+  /// p_hat = sum N_j p_j, enters the total stress: f_i += V p_hat grad N_i.
+  void map_pore_pressure_force() {
+    StencilT s;
+    for (std::size_t p = 0; p < particles_.size(); ++p) {
+      if (!constants_[particles_.material[p]].saturated) continue;
+      stencil_of(p, s);
+      double p_hat = 0.0;
+      for (int k = 0; k < StencilT::N; ++k) p_hat += s.w[k] * grid_.pressure[s.node[k]];
+      const double vp = particles_.volume[p] * p_hat;
+      for (int k = 0; k < StencilT::N; ++k)
+        grid_.force[s.node[k]] += vp * Eigen::Map<const Vec>(s.grad[k].data());
+    }
+  }
+
+  /// Surface loads, mapped at the loaded face of each selected particle.
+  void apply_tractions(double t) {
+    StencilT s;
+    for (const TractionLoad& load : tractions_) {
+      Vec traction;
+      for (int a = 0; a < Dim; ++a)
+        traction[a] = load.source->traction[a] ? load.source->traction[a](t) : 0.0;
+      for (std::size_t k = 0; k < load.particles.size(); ++k) {
+        const auto p = static_cast<std::size_t>(load.particles[k]);
+        const double stretch = std::pow(particles_.volume[p] / load.volume0[k], 1.0 / Dim);
+        const double area = particles_.volume[p] / load.length0[k];
+        Vec face = particles_.x[p];
+        face[load.axis] += load.side * 0.5 * load.length0[k] * stretch;
+        s.compute(face, grid_.origin, grid_.inv_h, grid_.cells, grid_.stride,
+                  particles_.half_length.empty() ? 0.0 : particles_.half_length[p]);
+        for (int n = 0; n < StencilT::N; ++n) grid_.force[s.node[n]] += s.w[n] * area * traction;
+      }
+    }
+  }
+
+  /// Grid update: momentum += dt f (with local damping), then prescribed
+  /// velocities at t + dt. Gives the Lagrangian nodal velocity and the
+  /// nodal acceleration used by the particles.
+  void update_nodal_momentum(double t, double dt) {
+    const double alpha = problem_.local_damping;
+    for (std::int64_t i = 0; i < grid_.count; ++i) {
+      const double m = grid_.mass[i];
+      if (m <= mass_tolerance_) {
+        grid_.velocity[i].setZero();
+        grid_.accel[i].setZero();
+        continue;
+      }
+      Vec f = grid_.force[i];
+      const Vec v0 = grid_.momentum[i] / m;
+      if (alpha > 0)
+        for (int a = 0; a < Dim; ++a)
+          f[a] -= alpha * std::abs(f[a]) * (v0[a] > 0 ? 1.0 : (v0[a] < 0 ? -1.0 : 0.0));
+      grid_.accel[i] = f / m;
+      grid_.velocity[i] = v0 + dt * grid_.accel[i];
+    }
+    for (const VelocityConstraint& bc : velocity_bcs_) {
+      for (int a = 0; a < Dim; ++a) {
+        if (!bc.fixed[a]) continue;
+        const double v_old = (*bc.fn[a])(t), v_new = (*bc.fn[a])(t + dt);
+        for (std::int64_t i : bc.nodes) {
+          grid_.velocity[i][a] = v_new;
+          grid_.accel[i][a] = (v_new - v_old) / dt;
+        }
+      }
+    }
+  }
+
+  /// Phase 3: FLIP update of particle velocities, v_p += dt sum N_i a_i, and
+  /// re-mapping of the updated momentum (MUSL, Eq. 26). Saturated particles
+  /// also compute their Darcy velocity here, where the nodal pressure
+  /// gradient and the solid acceleration of this step are both at hand.
+  void update_particle_velocities_and_remap(double dt) {
+    StencilT s;
+    for (std::size_t p = 0; p < particles_.size(); ++p) {
+      stencil_of(p, s);
+      Vec a = Vec::Zero();
+      for (int k = 0; k < StencilT::N; ++k) a += s.w[k] * grid_.accel[s.node[k]];
+      particles_.v[p] += dt * a;
+      const Vec mv = particles_.mass[p] * particles_.v[p];
+      for (int k = 0; k < StencilT::N; ++k) grid_.remap[s.node[k]] += s.w[k] * mv;
+      if (fluid_) {
+        const std::uint16_t mat = particles_.material[p];
+        const MaterialConstants& mc = constants_[mat];
+        if (!mc.saturated) continue;
+        Vec grad_p = Vec::Zero();
+        for (int k = 0; k < StencilT::N; ++k)
+          grad_p += grid_.pressure[s.node[k]] * Eigen::Map<const Vec>(s.grad[k].data());
+        particles_.darcy[p] =
+            -mc.permeability_over_gamma * (grad_p - mc.fluid_density * gravity_ +
+                                           darcy_inertia_ * mc.fluid_density * a);
+      }
+    }
+  }
+
+  void compute_remapped_nodal_velocity(double t_new) {
+    for (std::int64_t i = 0; i < grid_.count; ++i) {
+      const double m = grid_.mass[i];
+      grid_.remap[i] = m > mass_tolerance_ ? Vec(grid_.remap[i] / m) : Vec::Zero();
+    }
+    for (const VelocityConstraint& bc : velocity_bcs_)
+      for (int a = 0; a < Dim; ++a) {
+        if (!bc.fixed[a]) continue;
+        const double v = (*bc.fn[a])(t_new);
+        for (std::int64_t i : bc.nodes) grid_.remap[i][a] = v;
+      }
+  }
+
+  /// Phase 4: strain increment from the re-mapped nodal velocities, stress
+  /// update, volume and porosity; the fluid flux of the mass balance,
+  /// -N V div v + V grad N . w, is scattered to the nodes. When Move, the
+  /// particles also move with the Lagrangian nodal velocity (dry runs; in
+  /// saturated runs the last phase moves them).
+  template <bool Move>
+  void update_particle_stress_and_fluid_flux(double dt) {
+    StencilT s;
+    for (std::size_t p = 0; p < particles_.size(); ++p) {
+      stencil_of(p, s);
+      Mat grad_v = Mat::Zero();
+      for (int k = 0; k < StencilT::N; ++k)
+        grad_v += grid_.remap[s.node[k]] * Eigen::Map<const Vec>(s.grad[k].data()).transpose();
+      const double vol = particles_.volume[p];
+      const std::uint16_t mat = particles_.material[p];
+      const MaterialConstants& mc = constants_[mat];
+      if (fluid_ && mc.saturated) {
+        const double div_v = grad_v.trace();
+        const Vec& w = particles_.darcy[p];
+        for (int k = 0; k < StencilT::N; ++k)
+          grid_.flux[s.node[k]] +=
+              vol * (Eigen::Map<const Vec>(s.grad[k].data()).dot(w) - s.w[k] * div_v);
+      }
+      Voigt de = Voigt::Zero();
+      for (int a = 0; a < Dim; ++a) de[a] = grad_v(a, a) * dt;
+      if constexpr (Dim >= 2) de[3] = 0.5 * (grad_v(0, 1) + grad_v(1, 0)) * dt;
+      if constexpr (Dim == 3) {
+        de[4] = 0.5 * (grad_v(1, 2) + grad_v(2, 1)) * dt;
+        de[5] = 0.5 * (grad_v(2, 0) + grad_v(0, 2)) * dt;
+      }
+      const double tr = de[0] + de[1] + de[2];
+      Voigt& sig = particles_.stress[p];
+      for (int c = 0; c < 3; ++c) sig[c] += mc.lambda * tr + 2.0 * mc.shear_modulus * de[c];
+      for (int c = 3; c < 6; ++c) sig[c] += 2.0 * mc.shear_modulus * de[c];
+      particles_.strain[p] += de;
+      const double j = (Mat::Identity() + dt * grad_v).determinant();
+      if (!(j > 0.0)) fail_volume(p, j);
+      particles_.volume[p] = vol * j;
+      if (fluid_ && mc.saturated) particles_.porosity[p] = 1.0 - (1.0 - particles_.porosity[p]) / j;
+      if constexpr (Move) move_particle(p, s, dt);
+    }
+  }
+
+  /// Grid: ds p/dt from the scattered flux; free nodes advance, prescribed
+  /// nodes take their value at t + dt.
+  void update_nodal_pressure(double t_new, double dt) {
+    for (std::int64_t i = 0; i < grid_.count; ++i)
+      grid_.dp[i] = grid_.storage[i] > 0 ? dt * grid_.flux[i] / grid_.storage[i] : 0.0;
+    for (const PressureConstraint& bc : pressure_bcs_) {
+      const double value = (*bc.fn)(t_new);
+      for (std::int64_t i : bc.nodes) grid_.dp[i] = value - grid_.pressure[i];
+    }
+  }
+
+  /// Phase 5 (saturated): particle pressure state += sum N dp_i (FLIP);
+  /// reported pressure = sum N p_i^{n+1}; particles move.
+  void update_particle_pressure_and_position(double dt) {
+    StencilT s;
+    for (std::size_t p = 0; p < particles_.size(); ++p) {
+      stencil_of(p, s);
+      if (constants_[particles_.material[p]].saturated) {
+        double dp = 0.0, p_new = 0.0;
+        for (int k = 0; k < StencilT::N; ++k) {
+          const std::int64_t i = s.node[k];
+          dp += s.w[k] * grid_.dp[i];
+          p_new += s.w[k] * (grid_.pressure[i] + grid_.dp[i]);
+        }
+        particles_.pressure[p] += dp;
+        particles_.pressure_out[p] = p_new;
+        if (!std::isfinite(p_new)) fail_nonfinite(p, "pore pressure");
+      }
+      move_particle(p, s, dt);
+    }
+  }
+
+  inline void move_particle(std::size_t p, const StencilT& s, double dt) {
+    Vec dx = Vec::Zero();
+    for (int k = 0; k < StencilT::N; ++k) dx += s.w[k] * grid_.velocity[s.node[k]];
+    dx *= dt;
+    particles_.x[p] += dx;
+    particles_.u[p] += dx;
+    if (!particles_.x[p].allFinite() || !particles_.v[p].allFinite()) {
+      fail_nonfinite(p, "velocity");
+      return;
+    }
+    for (int a = 0; a < Dim; ++a) {
+      const double lo = grid_.origin[a], hi = grid_.origin[a] + grid_.cells[a] * grid_.h[a];
+      if (particles_.x[p][a] < lo || particles_.x[p][a] > hi) fail_left_grid(p);
+    }
+  }
+
+  // ------------------------------------------------------------ failures
+  // Called from hot loops only on the failure path; record the first one.
+  void fail_nonfinite(std::size_t p, const char* what) {
+    if (failed_) return;
+    failed_ = true;
+    failure_particle_ = static_cast<std::int64_t>(p);
+    failure_ = std::string("the ") + what + " became non-finite: the run diverged";
+    failure_hint_ = "reduce time.dt or time.courant (the stable step estimate is " +
+                    number(stable_.limit) + " s), and check moduli, densities and loads for "
+                    "unrealistic values";
+  }
+  void fail_left_grid(std::size_t p) {
+    if (failed_) return;
+    failed_ = true;
+    failure_particle_ = static_cast<std::int64_t>(p);
+    failure_ = "the particle left the grid";
+    failure_hint_ = "enlarge grid.min/grid.max so the grid contains the motion, or restrain the "
+                    "body with boundaries";
+  }
+  void fail_volume(std::size_t p, double j) {
+    if (failed_) return;
+    failed_ = true;
+    failure_particle_ = static_cast<std::int64_t>(p);
+    failure_ = "the particle volume became " + std::string(j <= 0 ? "negative or zero" : "non-finite") +
+               " (volume ratio " + number(j) + " in one step)";
+    failure_hint_ = "reduce time.dt or time.courant, refine the grid, or use a gimp/bspline "
+                    "shape_function for large deformations";
+  }
+
+  static std::string number(double v) {
+    std::ostringstream o;
+    o.precision(6);
+    o << v;
+    return o.str();
+  }
+
+  // ------------------------------------------------------------ output
+  void fill_snapshot(Snapshot& snap, const std::vector<Field>& fields) const;
+  void sample_series(Series& series, double t) const;
+
+  struct VelocityConstraint {
+    std::vector<std::int64_t> nodes;
+    std::array<bool, 3> fixed{false, false, false};
+    std::array<const FieldOfTime*, 3> fn{nullptr, nullptr, nullptr};
+  };
+  struct PressureConstraint {
+    std::vector<std::int64_t> nodes;
+    const FieldOfTime* fn = nullptr;
+  };
+  struct TractionLoad {
+    const Traction* source = nullptr;
+    int axis = 0;
+    int side = 1;
+    std::vector<std::int64_t> particles;
+    std::vector<double> length0;
+    std::vector<double> volume0;
+  };
+
+  const Problem& problem_;
+  GridState<Dim> grid_;
+  ParticleState<Dim> particles_;
+  std::vector<MaterialConstants> constants_;
+  std::vector<double> inv_ks_, inv_kf_;
+  std::vector<VelocityConstraint> velocity_bcs_;
+  std::vector<PressureConstraint> pressure_bcs_;
+  std::vector<TractionLoad> tractions_;
+  Vec gravity_ = Vec::Zero();
+  bool fluid_ = false;
+  double darcy_inertia_ = 1.0;  ///< weight of rho_f a in Darcy's law (1: as in the paper)
+  double mass_tolerance_ = 0.0;
+  StableStep stable_;
+
+  bool failed_ = false;
+  std::int64_t failure_particle_ = -1;
+  std::string failure_;
+  std::string failure_hint_;
+};
+
+}  // namespace hmpm
+
+#include "simulation_run.hpp"
