@@ -1,0 +1,220 @@
+"""The `python3 -m hmpm_client` command line.
+
+    python3 -m hmpm_client --url URL submit SPEC.json [--wait] [--download DIR]
+    python3 -m hmpm_client --url URL status ID | list [--status S] [--limit N]
+    python3 -m hmpm_client --url URL wait ID | results ID | download ID DIR
+    python3 -m hmpm_client --url URL cancel ID
+    python3 -m hmpm_client --url URL plot ID --field pore_pressure [--out FILE.png]
+
+Exit status: 0 success (for submit --wait and wait: the job succeeded);
+1 the service refused the request or could not be reached; 2 bad usage or a
+refused job spec (each JSON path and message on stderr); 3 the job failed or
+was dismissed (the reason on stderr); 4 matplotlib is missing (plot).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import sys
+from pathlib import Path
+from typing import Any, Dict, List, Optional
+
+from .client import DEFAULT_URL, Client, Job
+from .errors import HmpmError
+
+EXIT_OK, EXIT_ERROR, EXIT_INVALID, EXIT_JOB_FAILED, EXIT_NO_MATPLOTLIB = 0, 1, 2, 3, 4
+PROG = "hmpm_client"
+
+
+def _err(msg: str) -> None:
+    print(f"{PROG}: {msg}", file=sys.stderr)
+
+
+def _parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(
+        prog="python3 -m hmpm_client",
+        description="Submit, follow and download hmpm jobs.",
+        epilog="Exit status: 0 success; 1 request refused or service unreachable; 2 usage error or "
+               "invalid job spec (each JSON path on stderr); 3 job failed or dismissed; 4 matplotlib missing.",
+    )
+    p.add_argument("--url", default=os.environ.get("HMPM_URL") or DEFAULT_URL,
+                   help=f"service URL (default: $HMPM_URL or {DEFAULT_URL})")
+    p.add_argument("--token", default=None, help="bearer token (default: $HMPM_TOKEN)")
+    p.add_argument("--timeout", type=float, default=None,
+                   help="give up waiting for a job after this many seconds (default: no limit)")
+    sub = p.add_subparsers(dest="command", metavar="COMMAND")
+    sub.required = True
+
+    s = sub.add_parser("submit", help="submit a job spec (JSON file, or - for stdin)")
+    s.add_argument("spec", metavar="SPEC")
+    s.add_argument("--wait", action="store_true", help="show progress and wait until the job ends")
+    s.add_argument("--download", metavar="DIR", help="then download every result file into DIR (implies --wait)")
+    s.add_argument("--idempotency-key", metavar="KEY", help="repeat-safe submission key")
+    s.add_argument("--quiet", "-q", action="store_true", help="no progress bar")
+
+    s = sub.add_parser("status", help="print a job's status document")
+    s.add_argument("id")
+
+    s = sub.add_parser("wait", help="show progress and wait until a job ends")
+    s.add_argument("id")
+    s.add_argument("--quiet", "-q", action="store_true", help="no progress bar")
+
+    s = sub.add_parser("list", help="list jobs")
+    s.add_argument("--status", choices=["accepted", "running", "successful", "failed", "dismissed"])
+    s.add_argument("--limit", type=int)
+    s.add_argument("--json", action="store_true", help="print the status documents as JSON")
+
+    s = sub.add_parser("cancel", help="cancel a running job and dismiss it")
+    s.add_argument("id")
+
+    s = sub.add_parser("results", help="list a finished job's result files")
+    s.add_argument("id")
+
+    s = sub.add_parser("download", help="download a finished job's result files into DIR")
+    s.add_argument("id")
+    s.add_argument("dir")
+
+    s = sub.add_parser("plot", help="plot the time histories of the series particles")
+    s.add_argument("id")
+    s.add_argument("--field", default="pore_pressure", help="series field (default: pore_pressure)")
+    s.add_argument("--out", metavar="FILE.png", help="output file (default: ID-FIELD.png)")
+    return p
+
+
+def _print_json(doc: Any) -> None:
+    print(json.dumps(doc, indent=2, sort_keys=False))
+
+
+def _status_line(doc: Dict[str, Any]) -> str:
+    progress = doc.get("progress")
+    pct = f"{float(progress):5.1f}%" if isinstance(progress, (int, float)) else "    ?"
+    msg = str(doc.get("message") or "")
+    return f"{doc.get('jobID', '?')}  {str(doc.get('status', '?')):<10} {pct}  {doc.get('created', '')}  {msg}"
+
+
+def _finish(job: Job, doc: Dict[str, Any]) -> int:
+    status = doc.get("status")
+    if status == "successful":
+        return EXIT_OK
+    reason = doc.get("message") or "no reason given"
+    _err(f"job {job.id} {status}: {reason}")
+    return EXIT_JOB_FAILED
+
+
+def _wait(job: Job, args) -> Dict[str, Any]:
+    return job.wait(progress=not getattr(args, "quiet", False), timeout=args.timeout)
+
+
+def _download(job: Job, directory: str) -> None:
+    paths = job.download(directory)
+    print(f"{PROG}: downloaded {len(paths)} files to {directory} (sha256 verified)", file=sys.stderr)
+
+
+def cmd_submit(client: Client, args) -> int:
+    if args.spec == "-":
+        spec: Any = sys.stdin.buffer.read()
+    else:
+        if not Path(args.spec).is_file():
+            _err(f"{args.spec}: no such file")
+            return EXIT_INVALID
+        spec = args.spec
+    job = client.submit(spec, idempotency_key=args.idempotency_key)
+    print(job.id, flush=True)
+    if not (args.wait or args.download):
+        return EXIT_OK
+    doc = _wait(job, args)
+    code = _finish(job, doc)
+    if args.download:
+        if code == EXIT_OK:
+            _download(job, args.download)
+        else:
+            # A failed job may still have a summary.json with the reason.
+            try:
+                _download(job, args.download)
+            except HmpmError:
+                pass
+    return code
+
+
+def cmd_status(client: Client, args) -> int:
+    _print_json(client.job(args.id).status())
+    return EXIT_OK
+
+
+def cmd_wait(client: Client, args) -> int:
+    job = client.job(args.id)
+    return _finish(job, _wait(job, args))
+
+
+def cmd_list(client: Client, args) -> int:
+    docs = client.jobs(status=args.status, limit=args.limit)
+    if args.json:
+        _print_json(docs)
+    else:
+        for d in docs:
+            print(_status_line(d))
+    return EXIT_OK
+
+
+def cmd_cancel(client: Client, args) -> int:
+    doc = client.job(args.id).cancel()
+    print(_status_line(doc))
+    return EXIT_OK
+
+
+def cmd_results(client: Client, args) -> int:
+    for f in client.job(args.id).results():
+        print(f"{f.get('size', '?'):>12}  {f.get('sha256', '')}  {f.get('name')}")
+    return EXIT_OK
+
+
+def cmd_download(client: Client, args) -> int:
+    _download(client.job(args.id), args.dir)
+    return EXIT_OK
+
+
+def cmd_plot(client: Client, args) -> int:
+    from .plot import MatplotlibMissing, plot_series
+    job = client.job(args.id)
+    out = Path(args.out or f"{args.id}-{args.field}.png")
+    try:
+        series = job.series()
+        plot_series(series, args.field, out, title=f"job {args.id}: {args.field}")
+    except MatplotlibMissing as e:
+        _err(str(e))
+        return EXIT_NO_MATPLOTLIB
+    except ValueError as e:
+        _err(str(e))
+        return EXIT_ERROR
+    print(out)
+    return EXIT_OK
+
+
+COMMANDS = {
+    "submit": cmd_submit, "status": cmd_status, "wait": cmd_wait, "list": cmd_list,
+    "cancel": cmd_cancel, "results": cmd_results, "download": cmd_download, "plot": cmd_plot,
+}
+
+
+def main(argv: Optional[List[str]] = None) -> int:
+    args = _parser().parse_args(argv)
+    client = Client(args.url, token=args.token)
+    try:
+        return COMMANDS[args.command](client, args)
+    except HmpmError as e:
+        if e.errors:
+            _err(f"job spec refused: {e}")
+            return EXIT_INVALID
+        _err(str(e))
+        return EXIT_ERROR
+    except TimeoutError as e:
+        _err(str(e))
+        return EXIT_ERROR
+    except KeyboardInterrupt:
+        _err("interrupted (the job keeps running on the service; cancel it with: cancel ID)")
+        return 130
+    except OSError as e:
+        _err(str(e))
+        return EXIT_ERROR

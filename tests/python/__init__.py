@@ -1,0 +1,1 @@
+"""Python client tests (a package so `unittest discover -t .` can import them)."""

@@ -1,0 +1,204 @@
+"""The hmpm_client library against a live hmpm-server (see support.py)."""
+
+from __future__ import annotations
+
+import hashlib
+import io
+import json
+import os
+import unittest
+import uuid
+from unittest import mock
+
+from hmpm_client import Client, HmpmError
+
+from .support import JOB_TIMEOUT_S, LiveServerCase, bar_spec, invalid_spec, long_spec, wait_until
+
+
+class ClientTest(LiveServerCase):
+    def setUp(self):
+        super().setUp()
+        self.client = Client(self.server.url, token="")
+
+    def run_small_job(self):
+        job = self.client.submit(bar_spec(), idempotency_key=None)
+        doc = job.wait(progress=False, timeout=JOB_TIMEOUT_S)
+        self.assertEqual(doc["status"], "successful", f"{doc}\n{self.server.log_tail()}")
+        return job
+
+    def test_health(self):
+        self.assertIsNotNone(self.client.health())
+
+    def test_submit_returns_status_document(self):
+        job = self.client.submit(bar_spec())
+        self.assertTrue(job.id)
+        self.assertIn(job.doc.get("status"), ("accepted", "running", "successful"))
+        doc = job.status()
+        self.assertEqual(doc["jobID"], job.id)
+        for key in ("status", "progress", "created", "links"):
+            self.assertIn(key, doc)
+        job.wait(progress=False, timeout=JOB_TIMEOUT_S)
+
+    def test_submit_from_path_and_text(self):
+        path = self.tmp / "bar.json"
+        path.write_text(json.dumps(bar_spec()))
+        for spec in (str(path), path, path.read_text()):
+            job = self.client.submit(spec)
+            self.assertEqual(job.wait(progress=False, timeout=JOB_TIMEOUT_S)["status"], "successful")
+
+    def test_wait_download_checks_every_file(self):
+        job = self.run_small_job()
+        self.assertEqual(job.doc.get("progress"), 100)
+        manifest = job.results()
+        names = {f["name"] for f in manifest}
+        for required in ("summary.json", "series.json", "series.csv", "snapshots.pvd"):
+            self.assertIn(required, names)
+        self.assertTrue(any(n.endswith(".vtu") for n in names), names)
+        written = job.download(self.tmp / "out")
+        self.assertEqual(len(written), len(manifest))
+        for f in manifest:
+            data = (self.tmp / "out" / f["name"]).read_bytes()
+            self.assertEqual(len(data), f["size"], f["name"])
+            self.assertEqual(hashlib.sha256(data).hexdigest(), f["sha256"].lower(), f["name"])
+        self.assertEqual(list((self.tmp / "out").rglob("*.part")), [])
+        summary = json.loads((self.tmp / "out" / "summary.json").read_text())
+        self.assertEqual(summary["status"], "successful")
+
+    def test_series(self):
+        job = self.run_small_job()
+        series = job.series()
+        times = series["time"]
+        self.assertGreater(len(times), 10)
+        self.assertEqual(sorted(p["index"] for p in series["particles"]), [0, 6, 12])
+        for p in series["particles"]:
+            self.assertEqual(len(p["displacement"]), len(times))
+            self.assertEqual(len(p["velocity"][0]), 1)
+
+    def test_results_not_ready(self):
+        job = self.client.submit(long_spec())
+        try:
+            with self.assertRaises(HmpmError) as ctx:
+                job.results()
+            self.assertEqual(ctx.exception.status, 404)
+            self.assertTrue(ctx.exception.type_is("result-not-ready"), ctx.exception.problem)
+        finally:
+            job.cancel()
+
+    def test_invalid_spec_lists_every_path(self):
+        with self.assertRaises(HmpmError) as ctx:
+            self.client.submit(invalid_spec())
+        err = ctx.exception
+        self.assertIn(err.status, (400, 422))
+        self.assertGreaterEqual(len(err.errors), 2, err.problem)
+        text = str(err)
+        for e in err.errors:
+            self.assertIn(f"{e['path']}: {e['message']}", text)
+        self.assertTrue(any("youngs_modulus" in e["path"] for e in err.errors), err.errors)
+        self.assertTrue(any("/time" in e["path"] for e in err.errors), err.errors)
+
+    def test_not_json_is_a_problem_document(self):
+        with self.assertRaises(HmpmError) as ctx:
+            self.client.submit(b"this is not json")
+        self.assertEqual(ctx.exception.status, 400)
+        self.assertTrue(ctx.exception.title)
+
+    def test_unknown_job(self):
+        with self.assertRaises(HmpmError) as ctx:
+            self.client.job("no-such-job").status()
+        self.assertEqual(ctx.exception.status, 404)
+
+    def test_cancel_running_job(self):
+        job = self.client.submit(long_spec())
+        self.assertTrue(wait_until(lambda: job.status()["status"] == "running", 30),
+                        f"job never ran: {job.doc}")
+        doc = job.cancel()
+        self.assertIn(doc["status"], ("running", "dismissed"))
+        self.assertTrue(wait_until(lambda: job.status()["status"] == "dismissed", 10), job.doc)
+        final = job.wait(progress=False, timeout=10)
+        self.assertEqual(final["status"], "dismissed")
+
+    def test_list_filter_and_limit(self):
+        done = self.run_small_job()
+        all_jobs = self.client.jobs()
+        self.assertIn(done.id, [d["jobID"] for d in all_jobs])
+        successful = self.client.jobs(status="successful")
+        self.assertTrue(successful)
+        self.assertTrue(all(d["status"] == "successful" for d in successful))
+        self.assertEqual(len(self.client.jobs(limit=1)), 1)
+
+    def test_idempotency_key_returns_the_same_job(self):
+        key = str(uuid.uuid4())
+        first = self.client.submit(bar_spec(), idempotency_key=key)
+        second = self.client.submit(bar_spec(), idempotency_key=key)
+        self.assertEqual(first.id, second.id)
+        first.wait(progress=False, timeout=JOB_TIMEOUT_S)
+
+    def test_progress_bar_follows_events(self):
+        out = io.StringIO()
+        job = self.client.submit(bar_spec(end=2.0))
+        doc = job.wait(progress=True, timeout=JOB_TIMEOUT_S, file=out)
+        self.assertEqual(doc["status"], "successful")
+        text = out.getvalue()
+        self.assertIn(job.id, text)
+        self.assertIn("100.0%", text)
+        self.assertIn("successful", text.splitlines()[-1])
+
+    def test_wait_falls_back_to_polling(self):
+        job = self.client.submit(bar_spec())
+        # Refuse the event stream: the client must notice and poll instead.
+        real_open = self.client.open
+
+        def open_without_events(method, path, *a, **kw):
+            if path.endswith("/events"):
+                raise HmpmError({"type": "about:blank", "title": "stream refused"}, 503)
+            return real_open(method, path, *a, **kw)
+
+        self.client.open = open_without_events
+        try:
+            doc = job.wait(progress=False, timeout=JOB_TIMEOUT_S, poll_interval=0.2)
+        finally:
+            del self.client.open
+        self.assertEqual(doc["status"], "successful")
+
+    def test_polling_only(self):
+        job = self.client.submit(bar_spec())
+        doc = job.wait(progress=False, events=False, timeout=JOB_TIMEOUT_S, poll_interval=0.2)
+        self.assertEqual(doc["status"], "successful")
+
+    def test_wait_timeout_is_bounded(self):
+        job = self.client.submit(long_spec())
+        try:
+            with self.assertRaises(TimeoutError):
+                job.wait(progress=False, timeout=1.0)
+        finally:
+            job.cancel()
+
+
+class TokenTest(LiveServerCase):
+    TOKEN = server_token = "s3cret-" + uuid.uuid4().hex
+    server_workers = 1
+
+    def test_health_is_open(self):
+        self.assertIsNotNone(Client(self.server.url, token="").health())
+
+    def test_missing_and_wrong_token_are_refused(self):
+        for token in ("", "wrong"):
+            with self.assertRaises(HmpmError) as ctx:
+                Client(self.server.url, token=token).jobs()
+            self.assertEqual(ctx.exception.status, 401)
+
+    def test_token_from_argument(self):
+        client = Client(self.server.url, token=self.TOKEN)
+        job = client.submit(bar_spec())
+        self.assertEqual(job.wait(progress=False, timeout=JOB_TIMEOUT_S)["status"], "successful")
+        self.assertTrue(job.download(self.tmp / "out"))
+
+    def test_token_from_environment(self):
+        with mock.patch.dict(os.environ, {"HMPM_TOKEN": self.TOKEN}):
+            client = Client(self.server.url)
+        self.assertEqual(client.token, self.TOKEN)
+        self.assertIsInstance(client.jobs(), list)
+
+
+if __name__ == "__main__":
+    unittest.main()
