@@ -162,7 +162,9 @@ class Client:
         if not job_id:
             raise HmpmError({"type": "bad-response", "title": "the service did not return a job id",
                              "detail": raw[:200].decode("utf-8", errors="replace")})
-        return Job(self, str(job_id), doc if isinstance(doc, dict) else {})
+        job = Job(self, str(job_id), doc if isinstance(doc, dict) else {})
+        job.end_time = _spec_end_time(body)
+        return job
 
     def job(self, job_id: str) -> "Job":
         """A handle on an existing job (no request is made)."""
@@ -193,6 +195,15 @@ def _spec_bytes(spec: SpecLike) -> bytes:
     return path.read_bytes()
 
 
+def _spec_end_time(body: bytes) -> Optional[float]:
+    """The spec's `time.end` in seconds, or None."""
+    try:
+        end = json.loads(body.decode("utf-8")).get("time", {}).get("end")
+    except (ValueError, UnicodeDecodeError, AttributeError):
+        return None
+    return float(end) if isinstance(end, (int, float)) and not isinstance(end, bool) else None
+
+
 def _safe_relative(name: str) -> Path:
     """`name` as a relative path that stays inside the download folder."""
     p = Path(name.replace("\\", "/"))
@@ -208,6 +219,7 @@ class Job:
         self.client = client
         self.id = job_id
         self.doc: Dict[str, Any] = dict(doc or {})
+        self.end_time: Optional[float] = None  # the spec's time.end, when known
 
     def __repr__(self) -> str:
         return f"Job({self.id!r}, status={self.doc.get('status')!r})"
@@ -250,7 +262,7 @@ class Job:
         read.
         """
         deadline = None if timeout is None else time.monotonic() + timeout
-        bar = ProgressBar(self.id, file) if progress else None
+        bar = ProgressBar(self.id, file, self.end_time) if progress else None
         try:
             doc = self.status()
             if bar:

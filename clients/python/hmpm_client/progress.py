@@ -6,7 +6,9 @@ place with a carriage return; when the output is a file or a pipe (CI logs,
 tests) a new line is written only when the status changes or the progress
 crosses another 10 %, so logs stay short. `finish(doc)` ends the line.
 
-The ETA is extrapolated from the progress rate observed by this client since
+When the service reports only the percentage, the simulated time shown is
+that fraction of the spec's `time.end` (known when this client submitted the
+job). The ETA is extrapolated from the progress rate observed by this client since
 the job started running; it is never taken from the server's clock.
 """
 
@@ -51,7 +53,7 @@ class ProgressBar:
 
     width = 24
 
-    def __init__(self, job_id: str, file: Optional[TextIO] = None):
+    def __init__(self, job_id: str, file: Optional[TextIO] = None, end_time: Optional[float] = None):
         self.job_id = job_id
         self.file = file if file is not None else sys.stderr
         try:
@@ -63,7 +65,7 @@ class ProgressBar:
         self._last_status: Optional[str] = None
         self._last_decile = -1
         self._last_printed = ""
-        self._end_time: Optional[float] = None
+        self._end_time: Optional[float] = end_time
         self._finished = False
 
     def eta(self, progress: float, now: Optional[float] = None) -> Optional[float]:
@@ -89,6 +91,8 @@ class ProgressBar:
         if end is not None:
             self._end_time = end
         end = self._end_time
+        if sim is None and end is not None and status in ("running", "successful"):
+            sim = end * p / 100.0  # progress is the fraction of simulated time done
         if sim is not None and end is not None:
             parts.append(f"t={format_sim_time(sim)}/{format_sim_time(end)} s")
         elif sim is not None:
