@@ -98,7 +98,9 @@ def _finish(job: Job, doc: Dict[str, Any]) -> int:
     status = doc.get("status")
     if status == "successful":
         return EXIT_OK
-    reason = doc.get("message") or "no reason given"
+    reason = doc.get("reason") or doc.get("message") or "no reason given"
+    if doc.get("message") and doc.get("reason") and doc["message"] not in doc["reason"]:
+        reason = f"{doc['message']}: {doc['reason']}"
     _err(f"job {job.id} {status}: {reason}")
     return EXIT_JOB_FAILED
 

@@ -7,8 +7,8 @@ tests) a new line is written only when the status changes or the progress
 crosses another 10 %, so logs stay short. `finish(doc)` ends the line.
 
 When the service reports only the percentage, the simulated time shown is
-that fraction of the spec's `time.end` (known when this client submitted the
-job). The ETA is extrapolated from the progress rate observed by this client since
+that fraction of the run's end time: `cost.steps * cost.dt` from hmpm-server's
+status document, or the spec's `time.end` when this client submitted it. The ETA is extrapolated from the progress rate observed by this client since
 the job started running; it is never taken from the server's clock.
 """
 
@@ -88,6 +88,12 @@ class ProgressBar:
         parts = [f"{self.job_id} {status:<10}", f"[{bar}]", f"{p:5.1f}%"]
         sim = _number(doc, _SIM_TIME_KEYS)
         end = _number(doc, _END_TIME_KEYS)
+        cost = doc.get("cost")
+        if end is None and isinstance(cost, dict):
+            # hmpm-server's status document carries the step count and size.
+            steps, dt = _number(cost, ("steps",)), _number(cost, ("dt",))
+            if steps and dt:
+                end = steps * dt
         if end is not None:
             self._end_time = end
         end = self._end_time
