@@ -1,0 +1,28 @@
+// options.hpp — the hmpm-server command line, parsed into a ServiceConfig.
+//
+// Kept apart from main() so the tests can check every flag and every way to
+// get one wrong. Problems come back as a message, never as an exit.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "hmpm/server/service.hpp"
+
+namespace hmpm::server {
+
+struct ParsedOptions {
+  std::optional<ServiceConfig> config;  ///< set when `error` is empty and not `help`
+  std::string error;                    ///< what is wrong, for stderr
+  bool help = false;                    ///< --help was given
+};
+
+/// Parses `args` (without the program name). `env_token` is HMPM_TOKEN (may
+/// be null); --token wins over it.
+ParsedOptions parse_options(const std::vector<std::string>& args, const char* env_token);
+
+/// The --help text.
+std::string usage();
+
+}  // namespace hmpm::server

@@ -1,0 +1,66 @@
+// service.hpp — hmpm-server as a library: the durable job queue behind HTTP.
+//
+// A Service owns the SQLite job store, the worker threads that run jobs and
+// the HTTP front end (cpp-httplib). The `hmpm-server` executable and the
+// tests drive it the same way: construct it from a ServiceConfig (this opens
+// and migrates the database and recovers jobs an earlier process left
+// running), `bind()`, then `run()` on a thread of your own until `stop()` is
+// called from elsewhere (a signal handler thread, a test's TearDown).
+//
+// Routes, status codes and problem types are documented in docs/api.md.
+#pragma once
+
+#include <cstddef>
+#include <filesystem>
+#include <memory>
+#include <string>
+
+namespace hmpm::server {
+
+struct ServiceConfig {
+  std::string host = "127.0.0.1";
+  int port = 8080;                  ///< 0: any free port
+  std::filesystem::path db_path;    ///< SQLite file (created if missing)
+  std::filesystem::path data_dir;   ///< result files; empty: <db dir>/results
+  int workers = 1;                  ///< jobs run at the same time
+  int threads_per_job = 0;          ///< solver threads per job; <= 0: cores / workers
+  std::string token;                ///< non-empty: Bearer token required (not on /health)
+  long max_queue = 1000;            ///< accepted jobs before POST /jobs answers 503
+  double job_wall_time_s = 0.0;     ///< per-job wall-clock limit; <= 0: none
+  int max_attempts = 3;             ///< starts of one job before restart recovery fails it
+  std::size_t max_body_bytes = std::size_t{16} << 20;  ///< request body limit (413)
+  int max_event_streams = 8;        ///< concurrent GET /jobs/{id}/events (503 beyond)
+  int http_threads = 24;            ///< connections served at once
+  double progress_interval_s = 1.0; ///< how often a running job's progress is stored
+  double heartbeat_interval_s = 10.0;  ///< SSE comment line when nothing else was sent
+};
+
+class Service {
+ public:
+  /// Opens the database (throws hmpm::server::StoreFailure if it cannot),
+  /// creates the data folder and recovers interrupted jobs.
+  explicit Service(ServiceConfig config);
+  ~Service();
+  Service(const Service&) = delete;
+  Service& operator=(const Service&) = delete;
+
+  /// Binds the listening socket; returns the port, or -1 if binding failed.
+  int bind();
+  /// Starts the workers and serves until stop(); then cancels running jobs,
+  /// puts them back in the queue and joins every thread. Returns false if
+  /// serving could not start.
+  bool run();
+  /// Thread-safe and idempotent: stop accepting, end event streams, make
+  /// run() return.
+  void stop();
+  /// True once run() is accepting connections.
+  bool is_running() const;
+
+  const ServiceConfig& config() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace hmpm::server

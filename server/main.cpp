@@ -1,0 +1,64 @@
+// main.cpp — the hmpm-server executable: arguments, signals, one Service.
+//
+// SIGTERM and SIGINT are blocked in every thread and taken by a dedicated
+// thread with sigwait(), which asks the service to stop: it stops accepting,
+// puts running jobs back in the queue (they resume on the next start) and
+// run() returns, so the process exits 0. Exit 2 for bad arguments, 1 when
+// the database cannot be opened or the port cannot be bound.
+#include <pthread.h>
+#include <signal.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <iostream>
+#include <thread>
+
+#include "hmpm/server/options.hpp"
+#include "hmpm/server/service.hpp"
+#include "hmpm/server/store.hpp"
+
+int main(int argc, char** argv) {
+  const std::vector<std::string> args(argv + 1, argv + argc);
+  const auto parsed = hmpm::server::parse_options(args, std::getenv("HMPM_TOKEN"));
+  if (parsed.help) {
+    std::cout << hmpm::server::usage();
+    return 0;
+  }
+  if (!parsed.config) {
+    std::cerr << "hmpm-server: " << parsed.error << "\n" << hmpm::server::usage();
+    return 2;
+  }
+
+  // Block the stop signals before any thread exists, so all threads inherit
+  // the mask and only the signal thread below receives them.
+  sigset_t stop_signals;
+  sigemptyset(&stop_signals);
+  sigaddset(&stop_signals, SIGTERM);
+  sigaddset(&stop_signals, SIGINT);
+  pthread_sigmask(SIG_BLOCK, &stop_signals, nullptr);
+  signal(SIGPIPE, SIG_IGN);  // a client hanging up must not kill the server
+
+  try {
+    hmpm::server::Service service(*parsed.config);
+    const int port = service.bind();
+    if (port < 0) {
+      std::cerr << "hmpm-server: cannot listen on " << parsed.config->host << ":"
+                << parsed.config->port << "\n";
+      return 1;
+    }
+    std::thread signal_thread([&service, stop_signals] {
+      int signal_number = 0;
+      sigwait(&stop_signals, &signal_number);
+      service.stop();
+    });
+    signal_thread.detach();  // still waiting if run() ends by itself; exit ends it
+    std::cout << "listening on http://" << parsed.config->host << ":" << port << std::endl;
+    return service.run() ? 0 : 1;
+  } catch (const hmpm::server::StoreFailure& e) {
+    std::cerr << "hmpm-server: " << e.what() << "\n";
+    return 1;
+  } catch (const std::exception& e) {
+    std::cerr << "hmpm-server: " << e.what() << "\n";
+    return 1;
+  }
+}

@@ -1,0 +1,137 @@
+// options.cpp — see options.hpp.
+#include "hmpm/server/options.hpp"
+
+#include <charconv>
+#include <cmath>
+#include <functional>
+#include <map>
+
+namespace hmpm::server {
+namespace {
+
+bool parse_int(const std::string& text, long lo, long hi, long& out) {
+  long value = 0;
+  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
+  if (ec != std::errc() || end != text.data() + text.size() || value < lo || value > hi) return false;
+  out = value;
+  return true;
+}
+
+bool parse_seconds(const std::string& text, double& out) {
+  try {
+    std::size_t used = 0;
+    const double value = std::stod(text, &used);
+    if (used != text.size() || !std::isfinite(value) || value < 0) return false;
+    out = value;
+    return true;
+  } catch (const std::exception&) {
+    return false;
+  }
+}
+
+}  // namespace
+
+std::string usage() {
+  return "usage: hmpm-server [--host H] [--port P] --db PATH [--workers N] [--data-dir DIR]\n"
+         "                   [--threads-per-job N] [--token T] [--max-queue N]\n"
+         "                   [--job-wall-time S] [--max-attempts N] [--max-body-bytes N]\n"
+         "                   [--max-event-streams N] [--http-threads N]\n"
+         "  --host H              address to listen on (default 127.0.0.1)\n"
+         "  --port P              port; 0 picks a free one (default 8080)\n"
+         "  --db PATH             SQLite database, created if missing (required)\n"
+         "  --data-dir DIR        result files (default: <db dir>/results)\n"
+         "  --workers N           jobs run at the same time (default 1)\n"
+         "  --threads-per-job N   solver threads per job (default: cores / workers)\n"
+         "  --token T             require 'Authorization: Bearer T' (default: $HMPM_TOKEN)\n"
+         "  --max-queue N         queued jobs before POST /jobs answers 503 (default 1000)\n"
+         "  --job-wall-time S     fail a job running longer than S seconds (default: none)\n"
+         "  --max-attempts N      starts of a job before restart recovery fails it (default 3)\n"
+         "  --max-body-bytes N    request body limit, 413 beyond (default 16777216)\n"
+         "  --max-event-streams N concurrent event streams, 503 beyond (default 8)\n"
+         "  --http-threads N      connections served at once (default 24)\n"
+         "The first line on stdout is 'listening on http://HOST:PORT'. SIGTERM or SIGINT\n"
+         "stops accepting, puts running jobs back in the queue and exits 0.\n";
+}
+
+ParsedOptions parse_options(const std::vector<std::string>& args, const char* env_token) {
+  ParsedOptions result;
+  ServiceConfig config;
+  if (env_token) config.token = env_token;
+
+  auto integer = [](long lo, long hi, auto apply) {
+    return [=](const std::string& v) {
+      long n = 0;
+      if (!parse_int(v, lo, hi, n)) {
+        return "must be an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]";
+      }
+      apply(n);
+      return std::string();
+    };
+  };
+  // Each flag takes one value; the handler returns "" or what is wrong.
+  const std::map<std::string, std::function<std::string(const std::string&)>> flags{
+      {"--host", [&](const std::string& v) { config.host = v; return std::string(); }},
+      {"--port", integer(0, 65535, [&](long n) { config.port = static_cast<int>(n); })},
+      {"--db", [&](const std::string& v) { config.db_path = v; return std::string(); }},
+      {"--data-dir", [&](const std::string& v) { config.data_dir = v; return std::string(); }},
+      {"--workers", integer(1, 1024, [&](long n) { config.workers = static_cast<int>(n); })},
+      {"--threads-per-job",
+       integer(1, 4096, [&](long n) { config.threads_per_job = static_cast<int>(n); })},
+      {"--token", [&](const std::string& v) { config.token = v; return std::string(); }},
+      {"--max-queue", integer(0, 100'000'000, [&](long n) { config.max_queue = n; })},
+      {"--job-wall-time",
+       [&](const std::string& v) {
+         return parse_seconds(v, config.job_wall_time_s) ? std::string()
+                                                         : std::string("must be seconds >= 0");
+       }},
+      {"--max-attempts", integer(1, 1000, [&](long n) { config.max_attempts = static_cast<int>(n); })},
+      {"--max-body-bytes",
+       integer(1024, long{1} << 40, [&](long n) { config.max_body_bytes = static_cast<std::size_t>(n); })},
+      {"--max-event-streams",
+       integer(0, 1000, [&](long n) { config.max_event_streams = static_cast<int>(n); })},
+      {"--http-threads", integer(2, 1024, [&](long n) { config.http_threads = static_cast<int>(n); })},
+  };
+
+  for (std::size_t i = 0; i < args.size(); ++i) {
+    std::string flag = args[i];
+    std::string value;
+    bool has_value = false;
+    if (flag == "-h" || flag == "--help") {
+      result.help = true;
+      return result;
+    }
+    if (const auto eq = flag.find('='); flag.rfind("--", 0) == 0 && eq != std::string::npos) {
+      value = flag.substr(eq + 1);
+      flag = flag.substr(0, eq);
+      has_value = true;
+    }
+    const auto it = flags.find(flag);
+    if (it == flags.end()) {
+      result.error = "unknown option " + flag;
+      return result;
+    }
+    if (!has_value) {
+      if (i + 1 >= args.size()) {
+        result.error = flag + " needs a value";
+        return result;
+      }
+      value = args[++i];
+    }
+    if (const std::string problem = it->second(value); !problem.empty()) {
+      result.error = flag + " " + value + ": " + problem;
+      return result;
+    }
+  }
+  if (config.db_path.empty()) {
+    result.error = "--db PATH is required";
+    return result;
+  }
+  if (config.host.empty()) {
+    result.error = "--host must not be empty";
+    return result;
+  }
+  result.config = std::move(config);
+  return result;
+}
+
+}  // namespace hmpm::server

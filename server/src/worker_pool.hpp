@@ -1,0 +1,79 @@
+// worker_pool.hpp — the threads that run jobs, one job per worker at a time.
+//
+// Workers take the oldest accepted job from the store (FIFO), re-parse its
+// stored spec (the database stays the only source of truth), run it with
+// hmpm::api::run_job into `<data-dir>/<job id>/`, record the result files
+// with size and SHA-256, and write the outcome. HTTP handlers never run
+// solver work; they only nudge the pool (`notify`) or ask it to cancel.
+//
+// Cancellation is cooperative: each running job has an atomic flag the solver
+// checks once per step. A client's DELETE dismisses the job; a shutdown puts
+// it back in the queue so the next start resumes it.
+#pragma once
+
+#include <atomic>
+#include <condition_variable>
+#include <cstdint>
+#include <filesystem>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "hmpm/api/job.hpp"
+#include "hmpm/server/store.hpp"
+#include "metrics.hpp"
+
+namespace hmpm::server {
+
+struct WorkerSettings {
+  int workers = 1;
+  int threads_per_job = 1;
+  double wall_time_limit_s = 0.0;     ///< <= 0: none
+  double progress_interval_s = 1.0;   ///< how often progress reaches the store
+  std::filesystem::path data_dir;
+  hmpm::api::Limits limits;
+};
+
+class WorkerPool {
+ public:
+  WorkerPool(JobStore& store, Metrics& metrics, WorkerSettings settings);
+  ~WorkerPool();
+  WorkerPool(const WorkerPool&) = delete;
+  WorkerPool& operator=(const WorkerPool&) = delete;
+
+  void start();
+  /// Wakes an idle worker: a job was queued.
+  void notify();
+  /// Asks the worker running `id` to stop; its job stays dismissed. Returns
+  /// whether a worker of this process was running it.
+  bool cancel(const std::string& id);
+  /// Stops taking jobs, cancels the running ones, puts them back in the
+  /// queue and joins the threads. Idempotent.
+  void shutdown();
+
+  /// Where the result files of job `id` live.
+  std::filesystem::path job_dir(const std::string& id) const;
+
+ private:
+  struct Running {
+    std::atomic<bool> cancel{false};
+    std::atomic<bool> dismissed{false};
+  };
+  void work();
+  void run_one(const JobRecord& job, Running& running);
+
+  JobStore& store_;
+  Metrics& metrics_;
+  WorkerSettings settings_;
+  std::mutex mutex_;
+  std::condition_variable wake_;
+  bool stopping_ = false;
+  std::uint64_t generation_ = 0;  ///< bumped by notify()
+  std::map<std::string, std::shared_ptr<Running>> running_;
+  std::vector<std::thread> threads_;
+};
+
+}  // namespace hmpm::server
