@@ -1,7 +1,201 @@
-// main.cpp — placeholder for the `hmpm` command line.
-#include <cstdio>
+// main.cpp — the `hmpm` command line: validate a job spec or run it locally.
+//
+//   hmpm run SPEC.json --out DIR [--threads N] [--quiet]
+//   hmpm validate SPEC.json
+// SPEC may be "-" for standard input. Exit codes follow the contract:
+// 0 success, 2 invalid spec (every error on stderr as "/pointer: message"),
+// 3 run failed (reason on stderr and in DIR/summary.json); 1 for a bad
+// command line or an unreadable file.
+#include <unistd.h>
 
-int main() {
-  std::fputs("hmpm: not implemented yet\n", stderr);
-  return 1;
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <csignal>
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+#include <iterator>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "hmpm/api/job.hpp"
+
+namespace {
+
+constexpr int kExitOk = 0;
+constexpr int kExitUsage = 1;
+constexpr int kExitInvalid = 2;
+constexpr int kExitRunFailed = 3;
+
+std::atomic<bool> g_cancel{false};
+
+extern "C" void on_interrupt(int) { g_cancel.store(true); }
+
+const char* const kUsage =
+    "usage:\n"
+    "  hmpm run SPEC.json --out DIR [--threads N]   run a job locally, write results into DIR\n"
+    "  hmpm validate SPEC.json                      check a job spec, print its cost estimate\n"
+    "  hmpm spec-keys                               print the keys the parser accepts (JSON)\n"
+    "  hmpm --help | --version\n"
+    "SPEC may be '-' for standard input.\n"
+    "Exit codes: 0 success; 2 invalid spec (one '/json/pointer: message' line per problem\n"
+    "on stderr); 3 the run failed (reason on stderr and in DIR/summary.json); 1 bad usage.\n"
+    "--threads N: solver threads (default: every core). Ctrl-C stops a run cleanly.\n";
+
+int usage_error(const std::string& what) {
+  std::cerr << "hmpm: " << what << "\n" << kUsage;
+  return kExitUsage;
+}
+
+bool read_spec(const std::string& path, std::string& text) {
+  if (path == "-") {
+    text.assign(std::istreambuf_iterator<char>(std::cin), std::istreambuf_iterator<char>());
+    return true;
+  }
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return false;
+  std::ostringstream s;
+  s << in.rdbuf();
+  text = s.str();
+  return true;
+}
+
+// Reads and parses; prints errors and returns the exit code when not valid.
+int load(const std::string& path, hmpm::api::ParseResult& result) {
+  std::string text;
+  if (!read_spec(path, text)) {
+    std::cerr << "hmpm: cannot read " << path << "\n";
+    return kExitUsage;
+  }
+  result = hmpm::api::parse_job(text);
+  if (result.ok()) return kExitOk;
+  for (const auto& e : result.errors) std::cerr << e.path << ": " << e.message << "\n";
+  return kExitInvalid;
+}
+
+void print_cost(const hmpm::api::CostEstimate& c) {
+  std::cout << "particles " << c.particles << ", nodes " << c.nodes << ", steps " << c.steps << " (dt " << c.dt
+            << " s), particle-steps " << c.particle_steps << ", memory ~" << c.memory_bytes / 1024 / 1024
+            << " MiB, output ~" << c.output_bytes / 1024 << " KiB, series rows " << c.series_rows
+            << ", snapshots " << c.snapshots << "\n";
+}
+
+std::string format_seconds(double s) {
+  char buf[32];
+  if (s < 0 || s > 1e7) return "?";
+  if (s < 60) std::snprintf(buf, sizeof buf, "%.0f s", s);
+  else if (s < 3600) std::snprintf(buf, sizeof buf, "%dm%02ds", static_cast<int>(s) / 60, static_cast<int>(s) % 60);
+  else std::snprintf(buf, sizeof buf, "%dh%02dm", static_cast<int>(s) / 3600, static_cast<int>(s) / 60 % 60);
+  return buf;
+}
+
+int command_validate(const std::vector<std::string>& args) {
+  if (args.size() != 1) return usage_error("validate takes exactly one SPEC");
+  hmpm::api::ParseResult result;
+  if (const int rc = load(args[0], result); rc != kExitOk) return rc;
+  std::cout << "valid: " << result.job->name << "\n";
+  print_cost(result.job->cost);
+  return kExitOk;
+}
+
+int command_run(const std::vector<std::string>& args) {
+  std::string spec, out;
+  int threads = static_cast<int>(std::thread::hardware_concurrency());
+  for (std::size_t i = 0; i < args.size(); ++i) {
+    const std::string& a = args[i];
+    if (a == "--out" && i + 1 < args.size()) {
+      out = args[++i];
+    } else if (a == "--threads" && i + 1 < args.size()) {
+      try {
+        std::size_t used = 0;
+        threads = std::stoi(args[++i], &used);
+        if (used != args[i].size() || threads < 1) throw std::invalid_argument("");
+      } catch (const std::exception&) {
+        return usage_error("--threads needs a positive integer, got '" + args[i] + "'");
+      }
+    } else if (spec.empty() && (a == "-" || a.rfind("--", 0) != 0)) {
+      spec = a;
+    } else {
+      return usage_error("unexpected argument '" + a + "'");
+    }
+  }
+  if (spec.empty() || out.empty()) return usage_error("run needs SPEC and --out DIR");
+  hmpm::api::ParseResult result;
+  if (const int rc = load(spec, result); rc != kExitOk) return rc;
+
+  hmpm::RunOptions options;
+  options.threads = threads < 1 ? 1 : threads;
+  options.cancel = &g_cancel;
+  std::signal(SIGINT, on_interrupt);
+  std::signal(SIGTERM, on_interrupt);
+  const bool tty = isatty(STDERR_FILENO) == 1;
+  const auto start = std::chrono::steady_clock::now();
+  if (tty) {
+    options.on_progress = [start](const hmpm::Progress& p) {
+      const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      const double f = std::clamp(p.fraction, 0.0, 1.0);
+      const int width = 30, filled = static_cast<int>(f * width);
+      const double eta = f > 1e-6 ? elapsed * (1 - f) / f : -1;
+      std::fprintf(stderr, "\r[%s%s] %5.1f%%  t = %.4g / %.4g s  ETA %s   ", std::string(static_cast<std::size_t>(filled), '#').c_str(),
+                   std::string(static_cast<std::size_t>(width - filled), ' ').c_str(), 100 * f, p.time, p.end_time,
+                   format_seconds(eta).c_str());
+      std::fflush(stderr);
+    };
+  }
+  hmpm::api::JobOutcome outcome;
+  try {
+    outcome = hmpm::api::run_job(*result.job, out, options);
+  } catch (const std::exception& e) {
+    if (tty) std::fputs("\n", stderr);
+    std::cerr << "hmpm: " << e.what() << "\n";
+    return kExitRunFailed;
+  }
+  if (tty) std::fputs("\n", stderr);
+  const hmpm::RunResult& r = outcome.run;
+  for (const auto& w : r.warnings) std::cerr << "hmpm: warning: " << w << "\n";
+  if (r.status != hmpm::RunStatus::successful) {
+    std::cerr << "hmpm: run " << hmpm::status_name(r.status) << ": " << r.message << "\n";
+    return kExitRunFailed;
+  }
+  std::cout << "successful: " << r.steps << " steps of " << r.dt << " s, " << r.particles << " particles, "
+            << r.solve_seconds << " s (" << r.particle_steps_per_second << " particle-steps/s); results in "
+            << out << "\n";
+  return kExitOk;
+}
+
+int command_spec_keys() {
+  std::cout << "{";
+  bool first = true;
+  for (const auto& entry : hmpm::api::spec_object_keys()) {
+    std::cout << (first ? "\n" : ",\n") << "  \"" << entry.location << "\": [";
+    for (std::size_t i = 0; i < entry.keys.size(); ++i) std::cout << (i ? ", " : "") << '"' << entry.keys[i] << '"';
+    std::cout << "]";
+    first = false;
+  }
+  std::cout << "\n}\n";
+  return kExitOk;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::vector<std::string> args(argv + 1, argv + argc);
+  if (args.empty()) return usage_error("no command");
+  const std::string command = args[0];
+  args.erase(args.begin());
+  if (command == "--help" || command == "-h" || command == "help") {
+    std::cout << "hmpm " << hmpm::api::version() << " — hydro-mechanical MPM for saturated soils\n" << kUsage;
+    return kExitOk;
+  }
+  if (command == "--version") {
+    std::cout << "hmpm " << hmpm::api::version() << "\n";
+    return kExitOk;
+  }
+  if (command == "validate") return command_validate(args);
+  if (command == "run") return command_run(args);
+  if (command == "spec-keys") return command_spec_keys();
+  return usage_error("unknown command '" + command + "'");
 }

@@ -1,12 +1,71 @@
-// run_job.cpp — placeholder while the writers are written.
+// run_job.cpp — one job run from a parsed spec to its result files.
+//
+// Wraps hmpm::run: snapshots are written as the solver hands them over (the
+// .pvd collection is rewritten after each, so partial results are usable),
+// the series after the loop, summary.json last and always — also when the
+// run failed or a file could not be written.
+#include <algorithm>
+#include <stdexcept>
+
 #include "hmpm/api/job.hpp"
+#include "writers.hpp"
 
 namespace hmpm::api {
 
-JobOutcome run_job(const ParsedJob& job, const std::filesystem::path&, const hmpm::RunOptions& options) {
-  JobOutcome out;
-  out.run = hmpm::run(job.problem, options);
-  return out;
+namespace fs = std::filesystem;
+
+JobOutcome run_job(const ParsedJob& job, const fs::path& out_dir, const hmpm::RunOptions& options) {
+  std::error_code ec;
+  fs::create_directories(out_dir, ec);
+  if (ec || !fs::is_directory(out_dir))
+    throw std::runtime_error("cannot create output directory " + out_dir.string() + ": " + ec.message());
+
+  JobOutcome outcome;
+  std::vector<std::pair<double, std::string>> snapshots;
+  std::string write_error;
+  RunOptions opts = options;
+  opts.on_snapshot = [&](const Snapshot& s) {
+    const std::string name = snapshot_file_name(s.index);
+    try {
+      write_snapshot_vtu(out_dir / name, s);
+      snapshots.emplace_back(s.time, name);
+      write_pvd(out_dir / "snapshots.pvd", snapshots);
+    } catch (const std::exception& e) {
+      write_error = e.what();
+      throw;  // ends the run; reported below
+    }
+    if (options.on_snapshot) options.on_snapshot(s);
+  };
+
+  try {
+    outcome.run = hmpm::run(job.problem, opts);
+  } catch (const std::exception& e) {
+    outcome.run.status = RunStatus::failed;
+    outcome.run.message = write_error.empty() ? std::string("the solver refused the problem: ") + e.what()
+                                              : "could not write results: " + write_error;
+  }
+
+  for (const auto& [time, name] : snapshots) outcome.files.push_back(name);
+  if (!snapshots.empty()) outcome.files.push_back("snapshots.pvd");
+  const OutputRequest& out = job.problem.output;
+  const bool series_requested = !out.series_particles.empty() && !out.series_fields.empty();
+  if (series_requested && write_error.empty()) {
+    try {
+      write_series_json(out_dir / "series.json", outcome.run.series);
+      write_series_csv(out_dir / "series.csv", outcome.run.series);
+      outcome.files.push_back("series.json");
+      outcome.files.push_back("series.csv");
+    } catch (const std::runtime_error& e) {
+      write_error = e.what();
+      outcome.run.status = RunStatus::failed;
+      outcome.run.message = std::string("could not write results: ") + e.what();
+    }
+  }
+  outcome.files.push_back("summary.json");
+  std::sort(outcome.files.begin(), outcome.files.end());
+  write_summary(out_dir / "summary.json", job.name, outcome.run, job.cost, outcome.files);
+  if (!write_error.empty()) throw std::runtime_error(write_error);
+  return outcome;
 }
 
 std::string media_type_for(std::string_view name) {

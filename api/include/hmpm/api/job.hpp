@@ -41,6 +41,7 @@ struct Limits {
   std::int64_t max_output_bytes = std::int64_t{4} << 30;  ///< estimated result size
   std::int64_t max_body_bytes = std::int64_t{16} << 20;   ///< size of the spec text
   int max_json_depth = 64;
+  std::int64_t max_series_particles = 10'000;  ///< entries of output.series.particles
 };
 
 /// What a job will cost, computed before it runs.
@@ -84,6 +85,23 @@ struct JobOutcome {
 /// were requested. Throws std::runtime_error only when files cannot be written.
 JobOutcome run_job(const ParsedJob& job, const std::filesystem::path& out_dir,
                    const hmpm::RunOptions& options = {});
+
+/// Cost of `problem` as `parse_job` computes it (particles, nodes, steps
+/// from the chosen dt, memory and output estimates). `problem` must have
+/// passed `hmpm::check_problem`.
+CostEstimate estimate_cost(const hmpm::Problem& problem);
+
+/// The keys `parse_job` accepts in each object of a spec. `location` is a
+/// JSON pointer pattern where "*" stands for any array index or material
+/// name (e.g. "/materials/*/hydraulic"). Used to keep the JSON Schema honest.
+struct SpecObjectKeys {
+  std::string location;
+  std::vector<std::string> keys;
+};
+const std::vector<SpecObjectKeys>& spec_object_keys();
+
+/// The hmpm version ("0.1.0"), as written into summary.json.
+const char* version();
 
 /// Media type of a result file by name ("application/json", "text/csv",
 /// "application/xml" for .pvd/.vtu, "application/octet-stream" otherwise).

@@ -1,0 +1,350 @@
+// writers.cpp — see writers.hpp.
+#include "writers.hpp"
+
+#include <charconv>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <stdexcept>
+
+namespace hmpm::api {
+
+namespace fs = std::filesystem;
+
+AtomicFile::AtomicFile(fs::path path) : path_(std::move(path)), tmp_(path_) {
+  tmp_ += ".tmp";
+  out_.open(tmp_, std::ios::binary | std::ios::trunc);
+  if (!out_) throw std::runtime_error("cannot create " + tmp_.string());
+}
+
+AtomicFile::~AtomicFile() {
+  if (committed_) return;
+  out_.close();
+  std::error_code ec;
+  fs::remove(tmp_, ec);
+}
+
+void AtomicFile::commit() {
+  out_.flush();
+  if (!out_) throw std::runtime_error("cannot write " + tmp_.string());
+  out_.close();
+  std::error_code ec;
+  fs::rename(tmp_, path_, ec);
+  if (ec) throw std::runtime_error("cannot rename " + tmp_.string() + " to " + path_.string() + ": " + ec.message());
+  committed_ = true;
+}
+
+void append_number(std::string& out, double v, bool json) {
+  if (!std::isfinite(v)) {
+    out += json ? "null" : (std::isnan(v) ? "nan" : (v > 0 ? "inf" : "-inf"));
+    return;
+  }
+  char buf[32];
+  const auto r = std::to_chars(buf, buf + sizeof buf, v);
+  out.append(buf, r.ptr);
+}
+
+namespace {
+
+std::string json_string(const std::string& s) {
+  std::string out = "\"";
+  for (unsigned char c : s) {
+    switch (c) {
+      case '"': out += "\\\""; break;
+      case '\\': out += "\\\\"; break;
+      case '\n': out += "\\n"; break;
+      case '\r': out += "\\r"; break;
+      case '\t': out += "\\t"; break;
+      default:
+        if (c < 0x20) {
+          char buf[8];
+          std::snprintf(buf, sizeof buf, "\\u%04x", c);
+          out += buf;
+        } else {
+          out += static_cast<char>(c);
+        }
+    }
+  }
+  return out + "\"";
+}
+
+const char* const kVectorSuffix[] = {"x", "y", "z"};
+const char* const kTensorSuffix[] = {"xx", "yy", "zz", "xy", "yz", "zx"};
+
+// Value of `field` (index f) for series particle p, row r, component c.
+double series_value(const Series& s, std::size_t f, std::size_t r, std::size_t p, int nc, int c) {
+  const std::size_t np = s.particles.size();
+  const std::size_t i = (r * np + p) * static_cast<std::size_t>(nc) + static_cast<std::size_t>(c);
+  return i < s.values[f].size() ? s.values[f][i] : std::nan("");
+}
+
+std::size_t series_rows(const Series& s) { return s.time.size(); }
+
+}  // namespace
+
+void write_summary(const fs::path& path, const std::string& job_name, const RunResult& run,
+                   const CostEstimate& cost, const std::vector<std::string>& files) {
+  std::string o = "{\n";
+  auto field = [&](const char* key, const std::string& raw, bool last = false) {
+    o += "  \"";
+    o += key;
+    o += "\": " + raw + (last ? "\n" : ",\n");
+  };
+  auto num = [](double v) {
+    std::string s;
+    append_number(s, v, true);
+    return s;
+  };
+  field("status", json_string(status_name(run.status)));
+  field("message", json_string(run.message));
+  field("steps", std::to_string(run.steps));
+  field("end_time", num(run.end_time));
+  field("dt", num(run.dt));
+  field("particles", std::to_string(run.particles));
+  field("nodes", std::to_string(run.nodes));
+  field("solve_seconds", num(run.solve_seconds));
+  field("particle_steps_per_second", num(run.particle_steps_per_second));
+  std::string warnings = "[";
+  for (std::size_t i = 0; i < run.warnings.size(); ++i) warnings += (i ? ", " : "") + json_string(run.warnings[i]);
+  field("warnings", warnings + "]");
+  field("name", json_string(job_name));
+  field("hmpm_version", json_string(version()));
+  field("state_bytes", std::to_string(run.state_bytes));
+  std::string c = "{\"particles\": " + std::to_string(cost.particles) + ", \"nodes\": " + std::to_string(cost.nodes) +
+                  ", \"cells\": " + std::to_string(cost.cells) + ", \"steps\": " + std::to_string(cost.steps) +
+                  ", \"dt\": " + num(cost.dt) + ", \"particle_steps\": " + std::to_string(cost.particle_steps) +
+                  ", \"memory_bytes\": " + std::to_string(cost.memory_bytes) +
+                  ", \"output_bytes\": " + std::to_string(cost.output_bytes) +
+                  ", \"series_rows\": " + std::to_string(cost.series_rows) +
+                  ", \"snapshots\": " + std::to_string(cost.snapshots) + "}";
+  field("cost", c);
+  std::string f = "[";
+  for (std::size_t i = 0; i < files.size(); ++i) f += (i ? ", " : "") + json_string(files[i]);
+  field("files", f + "]", true);
+  o += "}\n";
+  AtomicFile file(path);
+  file.stream() << o;
+  file.commit();
+}
+
+void write_series_json(const fs::path& path, const Series& s) {
+  AtomicFile file(path);
+  std::ostream& out = file.stream();
+  std::string line = "{\"time\": [";
+  for (std::size_t r = 0; r < s.time.size(); ++r) {
+    if (r) line += ", ";
+    append_number(line, s.time[r], true);
+  }
+  line += "],\n \"particles\": [";
+  out << line;
+  const std::size_t rows = series_rows(s);
+  for (std::size_t p = 0; p < s.particles.size(); ++p) {
+    line = p ? ",\n  {" : "\n  {";
+    line += "\"index\": " + std::to_string(s.particles[p]) + ", \"initial_position\": [";
+    for (int a = 0; a < s.dimension; ++a) {
+      if (a) line += ", ";
+      append_number(line, p < s.initial_positions.size() ? s.initial_positions[p][static_cast<std::size_t>(a)] : std::nan(""), true);
+    }
+    line += "]";
+    out << line;
+    for (std::size_t f = 0; f < s.fields.size() && f < s.values.size(); ++f) {
+      const int nc = field_components(s.fields[f], s.dimension);
+      line = ",\n   ";
+      line += json_string(field_name(s.fields[f]));
+      line += ": [";
+      for (std::size_t r = 0; r < rows; ++r) {
+        if (r) line += ", ";
+        if (nc > 1) line += "[";
+        for (int c = 0; c < nc; ++c) {
+          if (c) line += ", ";
+          append_number(line, series_value(s, f, r, p, nc, c), true);
+        }
+        if (nc > 1) line += "]";
+        if (line.size() > (1u << 16)) {
+          out << line;
+          line.clear();
+        }
+      }
+      line += "]";
+      out << line;
+    }
+    out << "}";
+  }
+  out << "\n ]\n}\n";
+  file.commit();
+}
+
+void write_series_csv(const fs::path& path, const Series& s) {
+  AtomicFile file(path);
+  std::ostream& out = file.stream();
+  std::string line = "time";
+  for (std::size_t p = 0; p < s.particles.size(); ++p) {
+    for (std::size_t f = 0; f < s.fields.size(); ++f) {
+      const int nc = field_components(s.fields[f], s.dimension);
+      for (int c = 0; c < nc; ++c) {
+        line += ",p" + std::to_string(s.particles[p]) + "_" + field_name(s.fields[f]);
+        // Vectors always carry an axis suffix (also in 1D), scalars none.
+        if (nc == 6) line += std::string("_") + kTensorSuffix[c];
+        else if (field_components(s.fields[f], 3) == 3) line += std::string("_") + kVectorSuffix[c];
+      }
+    }
+  }
+  out << line << '\n';
+  for (std::size_t r = 0; r < series_rows(s); ++r) {
+    line.clear();
+    append_number(line, s.time[r], false);
+    for (std::size_t p = 0; p < s.particles.size(); ++p)
+      for (std::size_t f = 0; f < s.fields.size() && f < s.values.size(); ++f) {
+        const int nc = field_components(s.fields[f], s.dimension);
+        for (int c = 0; c < nc; ++c) {
+          line += ',';
+          append_number(line, series_value(s, f, r, p, nc, c), false);
+        }
+      }
+    out << line << '\n';
+  }
+  file.commit();
+}
+
+// ------------------------------------------------------------------- VTU
+
+namespace {
+
+constexpr char kBase64[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+
+// Streams base64 of a byte sequence fed in pieces.
+class Base64Writer {
+ public:
+  explicit Base64Writer(std::ostream& out) : out_(out) {}
+  void write(const void* data, std::size_t n) {
+    const auto* bytes = static_cast<const unsigned char*>(data);
+    for (std::size_t i = 0; i < n; ++i) {
+      pending_[count_++] = bytes[i];
+      if (count_ == 3) flush_group();
+    }
+    if (buffer_.size() > (1u << 16)) {
+      out_ << buffer_;
+      buffer_.clear();
+    }
+  }
+  void finish() {
+    if (count_ > 0) {
+      const std::size_t n = count_;
+      for (std::size_t i = n; i < 3; ++i) pending_[i] = 0;
+      flush_group();
+      buffer_.resize(buffer_.size() - (3 - n));
+      buffer_.append(3 - n, '=');
+    }
+    out_ << buffer_;
+    buffer_.clear();
+  }
+
+ private:
+  void flush_group() {
+    const unsigned v = (unsigned{pending_[0]} << 16) | (unsigned{pending_[1]} << 8) | pending_[2];
+    buffer_ += kBase64[(v >> 18) & 63];
+    buffer_ += kBase64[(v >> 12) & 63];
+    buffer_ += kBase64[(v >> 6) & 63];
+    buffer_ += kBase64[v & 63];
+    count_ = 0;
+  }
+  std::ostream& out_;
+  unsigned char pending_[3] = {0, 0, 0};
+  std::size_t count_ = 0;
+  std::string buffer_;
+};
+
+// One inline binary DataArray: UInt64 byte count then the values, encoded
+// together (uncompressed layout of the VTK XML format).
+template <typename T, typename Source>
+void data_array(std::ostream& out, const char* type, const std::string& name, int components, std::size_t count,
+                Source value) {
+  out << "        <DataArray type=\"" << type << "\"";
+  if (!name.empty()) out << " Name=\"" << name << "\"";
+  if (components > 1) out << " NumberOfComponents=\"" << components << "\"";
+  out << " format=\"binary\">\n";
+  Base64Writer b64(out);
+  const std::uint64_t bytes = static_cast<std::uint64_t>(count) * static_cast<std::uint64_t>(components) * sizeof(T);
+  b64.write(&bytes, sizeof bytes);
+  for (std::size_t i = 0; i < count * static_cast<std::size_t>(components); ++i) {
+    const T v = value(i);
+    b64.write(&v, sizeof v);
+  }
+  b64.finish();
+  out << "\n        </DataArray>\n";
+}
+
+const std::vector<double>* snapshot_array(const Snapshot& s, Field f) {
+  switch (f) {
+    case Field::position: return &s.position;
+    case Field::displacement: return &s.displacement;
+    case Field::velocity: return &s.velocity;
+    case Field::pore_pressure: return &s.pore_pressure;
+    case Field::darcy_velocity: return &s.darcy_velocity;
+    case Field::effective_stress: return &s.effective_stress;
+    case Field::total_stress: return &s.total_stress;
+    case Field::strain: return &s.strain;
+    case Field::porosity: return &s.porosity;
+  }
+  return nullptr;
+}
+
+}  // namespace
+
+std::string snapshot_file_name(int index) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "snapshot_%04d.vtu", index);
+  return buf;
+}
+
+void write_snapshot_vtu(const fs::path& path, const Snapshot& s) {
+  static_assert(sizeof(double) == 8, "Float64 arrays");
+  const auto n = static_cast<std::size_t>(std::max<std::int64_t>(s.particles, 0));
+  AtomicFile file(path);
+  std::ostream& out = file.stream();
+  out << "<?xml version=\"1.0\"?>\n"
+         "<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">\n"
+         "  <UnstructuredGrid>\n"
+         "    <FieldData>\n"
+         "      <DataArray type=\"Float64\" Name=\"TimeValue\" NumberOfTuples=\"1\" format=\"ascii\">";
+  std::string t;
+  append_number(t, s.time, false);
+  out << t << "</DataArray>\n    </FieldData>\n";
+  out << "    <Piece NumberOfPoints=\"" << n << "\" NumberOfCells=\"" << n << "\">\n      <PointData>\n";
+  for (Field f : s.fields) {
+    if (f == Field::position) continue;  // the Points
+    const std::vector<double>* a = snapshot_array(s, f);
+    const int nc = field_components(f, 3);
+    if (a == nullptr || a->size() != n * static_cast<std::size_t>(nc)) continue;
+    data_array<double>(out, "Float64", field_name(f), nc, n, [&](std::size_t i) { return (*a)[i]; });
+  }
+  if (s.volume.size() == n)
+    data_array<double>(out, "Float64", "volume", 1, n, [&](std::size_t i) { return s.volume[i]; });
+  if (s.material.size() == n)
+    data_array<std::int32_t>(out, "Int32", "material", 1, n, [&](std::size_t i) { return s.material[i]; });
+  out << "      </PointData>\n      <Points>\n";
+  const bool have_points = s.position.size() == 3 * n;
+  data_array<double>(out, "Float64", "Points", 3, n, [&](std::size_t i) { return have_points ? s.position[i] : 0.0; });
+  out << "      </Points>\n      <Cells>\n";
+  data_array<std::int64_t>(out, "Int64", "connectivity", 1, n, [](std::size_t i) { return static_cast<std::int64_t>(i); });
+  data_array<std::int64_t>(out, "Int64", "offsets", 1, n, [](std::size_t i) { return static_cast<std::int64_t>(i + 1); });
+  data_array<std::uint8_t>(out, "UInt8", "types", 1, n, [](std::size_t) { return std::uint8_t{1}; });  // VTK_VERTEX
+  out << "      </Cells>\n    </Piece>\n  </UnstructuredGrid>\n</VTKFile>\n";
+  file.commit();
+}
+
+void write_pvd(const fs::path& path, const std::vector<std::pair<double, std::string>>& entries) {
+  AtomicFile file(path);
+  std::ostream& out = file.stream();
+  out << "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"LittleEndian\">\n"
+         "  <Collection>\n";
+  for (const auto& [time, name] : entries) {
+    std::string t;
+    append_number(t, time, false);
+    out << "    <DataSet timestep=\"" << t << "\" group=\"\" part=\"0\" file=\"" << name << "\"/>\n";
+  }
+  out << "  </Collection>\n</VTKFile>\n";
+  file.commit();
+}
+
+}  // namespace hmpm::api

@@ -1,0 +1,65 @@
+// writers.hpp — the contract's result files, written atomically.
+//
+// Every writer streams into "<name>.tmp" in the target directory and renames
+// it into place when complete, so a reader (the service, a user watching the
+// directory) never sees a half-written file. Snapshots are written one at a
+// time as the solver hands them over; nothing keeps them in memory.
+// All writers throw std::runtime_error when a file cannot be written.
+#pragma once
+
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "hmpm/api/job.hpp"
+#include "hmpm/run.hpp"
+
+namespace hmpm::api {
+
+/// A file that appears under its final name only when commit() succeeds;
+/// destroyed uncommitted, it removes its temporary file.
+class AtomicFile {
+ public:
+  explicit AtomicFile(std::filesystem::path path);
+  ~AtomicFile();
+  AtomicFile(const AtomicFile&) = delete;
+  AtomicFile& operator=(const AtomicFile&) = delete;
+  std::ostream& stream() { return out_; }
+  void commit();
+
+ private:
+  std::filesystem::path path_;
+  std::filesystem::path tmp_;
+  std::ofstream out_;
+  bool committed_ = false;
+};
+
+/// Appends the shortest round-trip text of `v` ("null" in JSON for non-finite).
+void append_number(std::string& out, double v, bool json);
+
+/// summary.json: status, message, steps, end_time, dt, particles, nodes,
+/// solve_seconds, particle_steps_per_second, plus warnings, name,
+/// hmpm_version, state_bytes, cost and the list of files.
+void write_summary(const std::filesystem::path& path, const std::string& job_name, const RunResult& run,
+                   const CostEstimate& cost, const std::vector<std::string>& files);
+
+/// series.json: {"time": [...], "particles": [{"index", "initial_position", <field>: rows}]}.
+void write_series_json(const std::filesystem::path& path, const Series& series);
+
+/// series.csv: header "time,p<index>_<field>[_<component>],..."; one row per time.
+void write_series_csv(const std::filesystem::path& path, const Series& series);
+
+/// One snapshot as a VTK UnstructuredGrid (.vtu): one vertex cell per
+/// particle, Points = positions, PointData = the snapshot's fields plus
+/// volume and material; base64-encoded little-endian binary, uncompressed.
+void write_snapshot_vtu(const std::filesystem::path& path, const Snapshot& snapshot);
+
+/// ParaView collection listing (time, file name) pairs.
+void write_pvd(const std::filesystem::path& path, const std::vector<std::pair<double, std::string>>& entries);
+
+/// "snapshot_0007.vtu" for index 7.
+std::string snapshot_file_name(int index);
+
+}  // namespace hmpm::api
