@@ -1,0 +1,62 @@
+// test_options.cpp — the hmpm-server command line: defaults, every flag,
+// HMPM_TOKEN, and the ways to get it wrong.
+#include <gtest/gtest.h>
+
+#include "hmpm/server/options.hpp"
+
+namespace hmpm::server {
+namespace {
+
+TEST(Options, DefaultsNeedOnlyTheDatabase) {
+  const auto parsed = parse_options({"--db", "x/db.sqlite"}, nullptr);
+  ASSERT_TRUE(parsed.config) << parsed.error;
+  EXPECT_EQ(parsed.config->host, "127.0.0.1");
+  EXPECT_EQ(parsed.config->port, 8080);
+  EXPECT_EQ(parsed.config->workers, 1);
+  EXPECT_EQ(parsed.config->max_attempts, 3);
+  EXPECT_TRUE(parsed.config->token.empty());
+  EXPECT_TRUE(parsed.config->data_dir.empty());  // resolved to <db dir>/results by the service
+}
+
+TEST(Options, EveryFlagIsRead) {
+  const auto parsed = parse_options(
+      {"--host", "0.0.0.0", "--port=0", "--db", "d.sqlite", "--workers", "3", "--data-dir", "res",
+       "--threads-per-job", "2", "--token", "t", "--max-queue", "5", "--job-wall-time", "1.5",
+       "--max-attempts", "4", "--max-body-bytes", "4096", "--max-event-streams", "2",
+       "--http-threads", "6"},
+      "env-token");
+  ASSERT_TRUE(parsed.config) << parsed.error;
+  const ServiceConfig& c = *parsed.config;
+  EXPECT_EQ(c.host, "0.0.0.0");
+  EXPECT_EQ(c.port, 0);
+  EXPECT_EQ(c.workers, 3);
+  EXPECT_EQ(c.data_dir, "res");
+  EXPECT_EQ(c.threads_per_job, 2);
+  EXPECT_EQ(c.token, "t");  // --token wins over HMPM_TOKEN
+  EXPECT_EQ(c.max_queue, 5);
+  EXPECT_DOUBLE_EQ(c.job_wall_time_s, 1.5);
+  EXPECT_EQ(c.max_attempts, 4);
+  EXPECT_EQ(c.max_body_bytes, 4096u);
+  EXPECT_EQ(c.max_event_streams, 2);
+  EXPECT_EQ(c.http_threads, 6);
+}
+
+TEST(Options, TokenComesFromTheEnvironment) {
+  const auto parsed = parse_options({"--db", "d"}, "s3cret");
+  ASSERT_TRUE(parsed.config);
+  EXPECT_EQ(parsed.config->token, "s3cret");
+}
+
+TEST(Options, MistakesAreReportedNotFatal) {
+  EXPECT_NE(parse_options({}, nullptr).error.find("--db"), std::string::npos);
+  EXPECT_NE(parse_options({"--db", "d", "--port", "70000"}, nullptr).error.find("--port"), std::string::npos);
+  EXPECT_NE(parse_options({"--db", "d", "--workers", "two"}, nullptr).error.find("--workers"), std::string::npos);
+  EXPECT_NE(parse_options({"--db", "d", "--workers", "0"}, nullptr).error.find("--workers"), std::string::npos);
+  EXPECT_NE(parse_options({"--db", "d", "--job-wall-time", "-1"}, nullptr).error.find("seconds"), std::string::npos);
+  EXPECT_NE(parse_options({"--db", "d", "--bogus", "1"}, nullptr).error.find("unknown option"), std::string::npos);
+  EXPECT_NE(parse_options({"--db"}, nullptr).error.find("needs a value"), std::string::npos);
+  EXPECT_TRUE(parse_options({"--help"}, nullptr).help);
+}
+
+}  // namespace
+}  // namespace hmpm::server

@@ -1,0 +1,398 @@
+// test_routes.cpp — the HTTP routes against a real in-process server.
+//
+// Each test starts hmpm::server::Service on an ephemeral loopback port with
+// its own database file and data folder (the fixture runs it on a thread and
+// stops it in TearDown), then talks to it with httplib::Client — or with raw
+// bytes where a request must be malformed on purpose.
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <regex>
+#include <set>
+#include <thread>
+
+#include "digest.hpp"
+#include "hmpm/server/service.hpp"
+#include "hmpm/server/store.hpp"
+#include "job_log.hpp"
+#include "support.hpp"
+
+namespace hmpm::server {
+namespace {
+
+using namespace hmpm::server::testing;
+using Clock = std::chrono::steady_clock;
+
+class RoutesTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    set_logging_enabled(false);
+    dir_ = make_temp_dir("routes");
+  }
+  void TearDown() override {
+    stop();
+    std::filesystem::remove_all(dir_);
+  }
+
+  ServiceConfig config() const {
+    ServiceConfig c;
+    c.port = 0;
+    c.db_path = dir_ / "db" / "hmpm.sqlite";
+    c.workers = 1;
+    c.threads_per_job = 1;
+    c.progress_interval_s = 0.2;
+    c.heartbeat_interval_s = 0.5;
+    return c;
+  }
+
+  void start(ServiceConfig c) {
+    service_ = std::make_unique<Service>(std::move(c));
+    port_ = service_->bind();
+    ASSERT_GT(port_, 0);
+    thread_ = std::thread([this] { service_->run(); });
+    const auto deadline = Clock::now() + std::chrono::seconds(5);
+    while (!service_->is_running() && Clock::now() < deadline) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
+    ASSERT_TRUE(service_->is_running());
+    client_ = std::make_unique<httplib::Client>("127.0.0.1", port_);
+    client_->set_read_timeout(30, 0);
+  }
+  void start() { start(config()); }
+
+  void stop() {
+    if (!service_) return;
+    service_->stop();
+    thread_.join();
+    service_.reset();
+  }
+
+  // POST /jobs; returns the new id ("" and a test failure otherwise).
+  std::string submit(const std::string& spec, const httplib::Headers& headers = {}) {
+    auto res = client_->Post("/jobs", headers, spec, "application/json");
+    EXPECT_TRUE(res);
+    if (!res) return "";
+    EXPECT_EQ(res->status, 201) << res->body;
+    const Json doc = json_of(res->body);
+    return doc.is_object() && doc.contains("jobID") ? doc["jobID"].get<std::string>() : "";
+  }
+
+  Json wait_until(const std::string& id, const std::string& status, double timeout_s = 60) {
+    return poll_job(*client_, id, [&](const Json& d) { return d.value("status", "") == status; },
+                    timeout_s);
+  }
+
+  Json wait_final(const std::string& id, double timeout_s = 60) {
+    return poll_job(*client_, id, is_final, timeout_s);
+  }
+
+  // Checks a problem document and returns it.
+  static Json expect_problem(const httplib::Result& res, int status, const std::string& type) {
+    EXPECT_TRUE(res);
+    if (!res) return {};
+    EXPECT_EQ(res->status, status) << res->body;
+    EXPECT_EQ(res->get_header_value("Content-Type"), "application/problem+json");
+    const Json doc = json_of(res->body);
+    EXPECT_TRUE(doc.is_object()) << res->body;
+    if (!doc.is_object()) return {};
+    EXPECT_EQ(doc.value("type", ""), type);
+    EXPECT_EQ(doc.value("status", 0), status);
+    EXPECT_FALSE(doc.value("title", "").empty());
+    EXPECT_FALSE(doc.value("detail", "").empty());
+    return doc;
+  }
+
+  std::filesystem::path dir_;
+  std::unique_ptr<Service> service_;
+  std::thread thread_;
+  int port_ = 0;
+  std::unique_ptr<httplib::Client> client_;
+};
+
+const std::regex rfc3339(R"(\d{4}-\d{2}-\d{2}T\d{2}:\d{2}:\d{2}(\.\d+)?Z)");
+
+TEST_F(RoutesTest, SubmitPollAndDownloadResults) {
+  start();
+  auto res = client_->Post("/jobs", small_spec("walk"), "application/json");
+  ASSERT_TRUE(res);
+  ASSERT_EQ(res->status, 201) << res->body;
+  const Json created = json_of(res->body);
+  const std::string id = created["jobID"];
+  EXPECT_TRUE(looks_like_uuid(id));
+  EXPECT_EQ(res->get_header_value("Location"), "/jobs/" + id);
+  EXPECT_EQ(created["status"], "accepted");
+  EXPECT_EQ(created["progress"], 0);
+  EXPECT_EQ(created["name"], "walk");
+  EXPECT_TRUE(std::regex_match(created["created"].get<std::string>(), rfc3339));
+  EXPECT_TRUE(created["started"].is_null());
+  EXPECT_GT(created["cost"]["particles"].get<int>(), 0);
+  std::set<std::string> rels;
+  for (const auto& l : created["links"]) rels.insert(l["rel"].get<std::string>());
+  EXPECT_EQ(rels, (std::set<std::string>{"self", "results", "events"}));
+
+  const Json done = wait_final(id);
+  ASSERT_EQ(done.value("status", ""), "successful") << done.dump();
+  EXPECT_EQ(done["progress"], 100);
+  EXPECT_EQ(done["attempts"], 1);
+  for (const char* key : {"created", "started", "finished", "updated"}) {
+    EXPECT_TRUE(std::regex_match(done[key].get<std::string>(), rfc3339)) << key;
+  }
+
+  res = client_->Get(("/jobs/" + id + "/results").c_str());
+  ASSERT_TRUE(res);
+  ASSERT_EQ(res->status, 200);
+  const Json manifest = json_of(res->body);
+  std::set<std::string> names;
+  for (const Json& f : manifest["files"]) {
+    const std::string name = f["name"];
+    names.insert(name);
+    EXPECT_EQ(f["href"], "/jobs/" + id + "/results/" + name);
+    auto file = client_->Get(f["href"].get<std::string>().c_str());
+    ASSERT_TRUE(file);
+    ASSERT_EQ(file->status, 200) << name;
+    EXPECT_EQ(f["size"].get<std::size_t>(), file->body.size()) << name;
+    EXPECT_EQ(f["sha256"], sha256_hex(file->body)) << name;
+    EXPECT_EQ(file->get_header_value("Content-Type"), f["media_type"]) << name;
+    // A conditional request with the ETag is answered without the body.
+    auto again = client_->Get(f["href"].get<std::string>().c_str(),
+                              {{"If-None-Match", file->get_header_value("ETag")}});
+    ASSERT_TRUE(again);
+    EXPECT_EQ(again->status, 304);
+  }
+  EXPECT_TRUE(names.count("summary.json"));
+  EXPECT_TRUE(names.count("series.json"));
+  EXPECT_TRUE(names.count("series.csv"));
+}
+
+TEST_F(RoutesTest, HostileBodiesGetProblemDocumentsAndTheServerKeepsAnswering) {
+  start();
+  const std::vector<std::string> bodies{"this is not JSON", "",
+                                        std::string(100000, '[') + std::string(100000, ']'),
+                                        std::string(100000, '{'), std::string("\xff\xfe\x00\x01", 4)};
+  for (const std::string& body : bodies) {
+    const Json doc = expect_problem(client_->Post("/jobs", body, "application/json"), 400, "invalid-spec");
+    ASSERT_TRUE(doc.contains("errors"));
+    ASSERT_FALSE(doc["errors"].empty());
+    EXPECT_TRUE(doc["errors"][0].contains("path"));
+    EXPECT_TRUE(doc["errors"][0].contains("message"));
+  }
+  Json spec = json_of(small_spec());
+  spec["materials"]["bar"]["youngs_modulus"] = -1.0;
+  spec["time"].erase("end");
+  const Json doc = expect_problem(client_->Post("/jobs", spec.dump(), "application/json"), 400, "invalid-spec");
+  std::set<std::string> paths;
+  for (const Json& e : doc["errors"]) paths.insert(e["path"].get<std::string>());
+  EXPECT_TRUE(paths.count("/materials/bar/youngs_modulus")) << doc.dump();
+  EXPECT_TRUE(paths.count("/time/end")) << doc.dump();
+
+  expect_problem(client_->Get("/jobs/00000000-0000-4000-8000-000000000000"), 404, "not-found");
+  expect_problem(client_->Get("/jobs/not-a-job"), 404, "not-found");
+  expect_problem(client_->Get("/nothing/here"), 404, "not-found");
+  expect_problem(client_->Put("/jobs", "{}", "application/json"), 405, "method-not-allowed");
+  expect_problem(client_->Get("/jobs?status=bogus"), 400, "invalid-parameter");
+  expect_problem(client_->Get("/jobs?limit=0"), 400, "invalid-parameter");
+  auto health = client_->Get("/health");
+  ASSERT_TRUE(health);
+  EXPECT_EQ(health->status, 200);
+  EXPECT_TRUE(json_of(client_->Get("/jobs")->body)["jobs"].empty());  // nothing was stored
+}
+
+TEST_F(RoutesTest, BodiesWithoutLengthOrOverTheLimitAreRefused) {
+  ServiceConfig c = config();
+  c.max_body_bytes = 64 * 1024;
+  start(c);
+  std::string res = raw_http(port_, "POST /jobs HTTP/1.1\r\nHost: x\r\nConnection: close\r\n\r\n{}");
+  EXPECT_EQ(raw_status(res), 411) << res;
+  EXPECT_EQ(json_of(raw_body(res)).value("type", ""), "length-required");
+  res = raw_http(port_,
+                 "POST /jobs HTTP/1.1\r\nHost: x\r\nTransfer-Encoding: chunked\r\nConnection: "
+                 "close\r\n\r\n2\r\n{}\r\n0\r\n\r\n");
+  EXPECT_EQ(raw_status(res), 411) << res;
+  res = raw_http(port_, "POST /jobs HTTP/1.1\r\nHost: x\r\nContent-Length: abc\r\nConnection: close\r\n\r\n");
+  EXPECT_EQ(raw_status(res), 400) << res;
+
+  const std::string big(200 * 1024, ' ');
+  expect_problem(client_->Post("/jobs", big, "application/json"), 413, "payload-too-large");
+  res = raw_http(port_, "POST /jobs HTTP/1.1\r\nHost: x\r\nContent-Length: " + std::to_string(big.size()) +
+                            "\r\nExpect: 100-continue\r\nConnection: close\r\n\r\n");
+  EXPECT_EQ(raw_status(res), 413) << res;  // refused before the body is sent
+  EXPECT_EQ(client_->Get("/health")->status, 200);
+}
+
+TEST_F(RoutesTest, TokenGuardsEverythingButHealth) {
+  ServiceConfig c = config();
+  c.token = "s3cret";
+  start(c);
+  EXPECT_EQ(client_->Get("/health")->status, 200);
+  auto res = client_->Get("/jobs");
+  expect_problem(res, 401, "unauthorized");
+  EXPECT_EQ(res->get_header_value("WWW-Authenticate").rfind("Bearer", 0), 0u);
+  expect_problem(client_->Get("/jobs", {{"Authorization", "Bearer wrong"}}), 401, "unauthorized");
+  expect_problem(client_->Get("/jobs", {{"Authorization", "Bearer s3cre"}}), 401, "unauthorized");
+  expect_problem(client_->Get("/metrics"), 401, "unauthorized");
+  expect_problem(client_->Post("/jobs", small_spec(), "application/json"), 401, "unauthorized");
+  expect_problem(client_->Delete("/jobs/00000000-0000-4000-8000-000000000000"), 401, "unauthorized");
+  res = client_->Get("/jobs", {{"Authorization", "bearer s3cret"}});
+  ASSERT_TRUE(res);
+  EXPECT_EQ(res->status, 200);
+  EXPECT_TRUE(json_of(res->body)["jobs"].empty());  // the unauthorised POST stored nothing
+  const std::string id = submit(small_spec(), {{"Authorization", "Bearer s3cret"}});
+  EXPECT_FALSE(id.empty());
+}
+
+TEST_F(RoutesTest, ResultNamesOutsideTheManifestAreRefused) {
+  start();
+  const std::string id = submit(small_spec());
+  ASSERT_EQ(wait_final(id).value("status", ""), "successful");
+  const std::string base = "/jobs/" + id + "/results/";
+  const std::vector<std::string> names{"..%2F..%2Fdb%2Fhmpm.sqlite", "%2E%2E%2Fsummary.json",
+                                       "nope.json", "..%2F" + id + "%2Fsummary.json"};
+  for (const std::string& name : names) {
+    expect_problem(client_->Get((base + name).c_str()), 404, "not-found");
+  }
+  const std::string res = raw_http(
+      port_, "GET " + base + "../../../db/hmpm.sqlite HTTP/1.1\r\nHost: x\r\nConnection: close\r\n\r\n");
+  EXPECT_EQ(raw_status(res), 404) << res;
+  EXPECT_EQ(client_->Get((base + "summary.json").c_str())->status, 200);
+}
+
+TEST_F(RoutesTest, CancelDismissesTheRunningJobWithinASecondAndTheWorkerTakesTheNext) {
+  start();
+  const std::string long_id = submit(long_spec("long", 10000));
+  ASSERT_EQ(wait_until(long_id, "running", 30).value("status", ""), "running");
+  const std::string next_id = submit(small_spec("next"));
+  expect_problem(client_->Get(("/jobs/" + next_id + "/results").c_str()), 404, "result-not-ready");
+  expect_problem(client_->Get(("/jobs/" + long_id + "/results").c_str()), 404, "result-not-ready");
+
+  const auto t0 = Clock::now();
+  auto res = client_->Delete(("/jobs/" + long_id).c_str());
+  ASSERT_TRUE(res);
+  ASSERT_EQ(res->status, 200) << res->body;
+  EXPECT_EQ(json_of(res->body)["status"], "dismissed");
+  // The worker is free again within a second: it has started the next job.
+  const Json next = poll_job(*client_, next_id, [](const Json& d) { return d.value("status", "") != "accepted"; }, 1.0);
+  EXPECT_NE(next.value("status", ""), "accepted") << "worker still busy after "
+                                                  << std::chrono::duration<double>(Clock::now() - t0).count() << " s";
+  EXPECT_EQ(wait_final(next_id).value("status", ""), "successful");
+  EXPECT_EQ(json_of(client_->Get(("/jobs/" + long_id).c_str())->body)["status"], "dismissed");
+  expect_problem(client_->Get(("/jobs/" + long_id + "/results").c_str()), 410, "job-dismissed");
+  EXPECT_FALSE(std::filesystem::exists(service_->config().data_dir / long_id));
+  // Dismissing a finished job removes its files too; dismissing again is harmless.
+  EXPECT_EQ(client_->Delete(("/jobs/" + next_id).c_str())->status, 200);
+  EXPECT_EQ(client_->Delete(("/jobs/" + next_id).c_str())->status, 200);
+  EXPECT_FALSE(std::filesystem::exists(service_->config().data_dir / next_id));
+}
+
+TEST_F(RoutesTest, IdempotencyKeyReturnsTheOriginalJob) {
+  start();
+  const httplib::Headers key{{"Idempotency-Key", "abc-123"}};
+  const std::string id = submit(small_spec("once"), key);
+  auto res = client_->Post("/jobs", key, small_spec("once"), "application/json");
+  ASSERT_TRUE(res);
+  EXPECT_EQ(res->status, 201);
+  EXPECT_EQ(json_of(res->body)["jobID"], id);
+  EXPECT_EQ(res->get_header_value("Idempotent-Replayed"), "true");
+  const Json conflict = expect_problem(client_->Post("/jobs", key, small_spec("twice"), "application/json"),
+                                       422, "idempotency-key-reused");
+  EXPECT_EQ(conflict.value("jobID", ""), id);
+  EXPECT_EQ(json_of(client_->Get("/jobs")->body)["jobs"].size(), 1u);
+}
+
+TEST_F(RoutesTest, FullQueueAnswers503WithRetryAfter) {
+  ServiceConfig c = config();
+  c.max_queue = 1;
+  start(c);
+  const std::string long_id = submit(long_spec("long", 10000));
+  ASSERT_EQ(wait_until(long_id, "running", 30).value("status", ""), "running");
+  submit(small_spec("waits"));
+  auto res = client_->Post("/jobs", small_spec("refused"), "application/json");
+  expect_problem(res, 503, "queue-full");
+  EXPECT_FALSE(res->get_header_value("Retry-After").empty());
+  client_->Delete(("/jobs/" + long_id).c_str());
+}
+
+TEST_F(RoutesTest, EventsStreamProgressAndTheFinalState) {
+  start();
+  const std::string id = submit(long_spec("streamed", 20));
+  std::string stream;
+  auto res = client_->Get(("/jobs/" + id + "/events").c_str(), [&](const char* data, std::size_t n) {
+    stream.append(data, n);
+    return stream.size() < (1 << 20);
+  });
+  ASSERT_TRUE(res);
+  EXPECT_EQ(res->status, 200);
+  EXPECT_EQ(res->get_header_value("Content-Type"), "text/event-stream");
+  EXPECT_NE(stream.find("event: progress\n"), std::string::npos) << stream.substr(0, 500);
+  const auto done = stream.find("event: done\ndata: ");
+  ASSERT_NE(done, std::string::npos) << stream.substr(0, 2000);
+  const Json final_doc = json_of(stream.substr(done + 18, stream.find('\n', done + 18) - done - 18));
+  EXPECT_EQ(final_doc.value("status", ""), "successful");
+  EXPECT_EQ(final_doc.value("jobID", ""), id);
+}
+
+TEST_F(RoutesTest, EventStreamsAreCapped) {
+  ServiceConfig c = config();
+  c.max_event_streams = 0;
+  start(c);
+  const std::string id = submit(small_spec());
+  auto res = client_->Get(("/jobs/" + id + "/events").c_str());
+  expect_problem(res, 503, "too-many-streams");
+  EXPECT_FALSE(res->get_header_value("Retry-After").empty());
+  expect_problem(client_->Get("/jobs/00000000-0000-4000-8000-000000000000/events"), 404, "not-found");
+}
+
+TEST_F(RoutesTest, ListFiltersAndMetricsCount) {
+  start();
+  const std::string a = submit(small_spec("a"));
+  ASSERT_EQ(wait_final(a).value("status", ""), "successful");
+  submit(small_spec("b"));
+  auto res = client_->Get("/jobs?status=successful&limit=10");
+  ASSERT_TRUE(res);
+  const Json list = json_of(res->body);
+  ASSERT_GE(list["jobs"].size(), 1u);
+  for (const Json& j : list["jobs"]) EXPECT_EQ(j["status"], "successful");
+  EXPECT_EQ(json_of(client_->Get("/jobs?limit=1")->body)["jobs"].size(), 1u);
+  EXPECT_EQ(json_of(client_->Get("/jobs?status=accepted,running,successful")->body)["jobs"].size(), 2u);
+
+  res = client_->Get("/metrics");
+  ASSERT_TRUE(res);
+  EXPECT_EQ(res->status, 200);
+  EXPECT_NE(res->body.find("hmpm_jobs{status=\"successful\"} "), std::string::npos) << res->body;
+  EXPECT_NE(res->body.find("hmpm_queue_length "), std::string::npos);
+  EXPECT_NE(res->body.find("hmpm_job_duration_seconds_count "), std::string::npos);
+  EXPECT_NE(res->body.find("hmpm_http_requests_total{code=\"201\"} 2"), std::string::npos) << res->body;
+}
+
+TEST_F(RoutesTest, StopRequeuesTheRunningJobAndTheNextStartFinishesIt) {
+  start();
+  const std::string id = submit(long_spec("interrupted", 100));
+  ASSERT_EQ(wait_until(id, "running", 30).value("status", ""), "running");
+  const auto t0 = Clock::now();
+  stop();
+  EXPECT_LT(std::chrono::duration<double>(Clock::now() - t0).count(), 5.0);
+  {
+    JobStore store(config().db_path);
+    const auto job = store.find(id);
+    ASSERT_TRUE(job);
+    EXPECT_EQ(job->status, JobStatus::accepted);
+    EXPECT_EQ(job->attempts, 0);  // a graceful stop is not the job's fault
+  }
+  start();
+  const Json done = wait_final(id, 90);
+  EXPECT_EQ(done.value("status", ""), "successful") << done.dump();
+  EXPECT_EQ(done.value("attempts", 0), 1);
+}
+
+TEST_F(RoutesTest, WallTimeLimitFailsTheJobWithAReason) {
+  ServiceConfig c = config();
+  c.job_wall_time_s = 0.5;
+  start(c);
+  const std::string id = submit(long_spec("too-long", 10000));
+  const Json done = wait_final(id, 30);
+  EXPECT_EQ(done.value("status", ""), "failed") << done.dump();
+  EXPECT_FALSE(done.value("reason", "").empty()) << done.dump();
+  EXPECT_FALSE(done.value("message", "").empty());
+}
+
+}  // namespace
+}  // namespace hmpm::server
