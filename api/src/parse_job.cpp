@@ -251,7 +251,7 @@ void JobParser::parse_grid(const json& j, const std::string& path) {
         }
       }
       if (total > static_cast<double>(limits_.max_cells))
-        r_.error(cp, "grid has " + format_number(total) + " cells; the limit is " +
+        r_.error(cp, "grid has " + format_count(total) + " cells; the limit is " +
                          std::to_string(limits_.max_cells));
     }
   }
@@ -656,7 +656,7 @@ bool JobParser::check_particle_budget() {
                            body.particles_per_cell;
       if (along > static_cast<double>(limits_.max_particles)) {
         r_.error(child_pointer("/bodies", b) + "/particles_per_cell",
-                 "body would have " + format_number(along) + " particles along " +
+                 "body would have " + format_count(along) + " particles along " +
                      std::string(kAxisNames[a]) + "; the limit is " + std::to_string(limits_.max_particles) +
                      " particles in all");
         return false;
@@ -666,7 +666,7 @@ bool JobParser::check_particle_budget() {
     total += n;
   }
   if (total > static_cast<double>(limits_.max_particles)) {
-    r_.error("/bodies", "the bodies would create " + format_number(total) + " particles; the limit is " +
+    r_.error("/bodies", "the bodies would create " + format_count(total) + " particles; the limit is " +
                             std::to_string(limits_.max_particles));
     return false;
   }
@@ -723,7 +723,7 @@ void JobParser::check_limits() {
     const std::string why = p_.time.dt ? "end " + format_number(p_.time.end) + " s / dt " + format_number(s.chosen) + " s"
                                        : "end " + format_number(p_.time.end) + " s / automatic dt " +
                                              format_number(s.chosen) + " s";
-    r_.error(p_.time.dt ? "/time/dt" : "/time/end", "the run needs " + format_number(steps) + " time steps (" +
+    r_.error(p_.time.dt ? "/time/dt" : "/time/end", "the run needs " + format_count(steps) + " time steps (" +
                                                         why + "); the limit is " +
                                                         std::to_string(limits_.max_steps));
   }

@@ -26,11 +26,101 @@ std::string child_pointer(const std::string& parent, std::size_t index) {
   return parent + "/" + std::to_string(index);
 }
 
+namespace {
+
+// Builds the document through nlohmann's SAX interface so that it knows,
+// at every moment, the JSON pointer of the value being read: a number that
+// overflows double is reported at its pointer, and so is a key that appears
+// twice in one object (nlohmann's DOM parser would silently keep the last).
+class DomBuilder {
+ public:
+  DomBuilder(json& root, std::vector<SpecError>& errors) : root_(root), errors_(errors) {}
+  bool failed() const { return failed_; }
+
+  bool null() { return value(json(nullptr)); }
+  bool boolean(bool v) { return value(json(v)); }
+  bool number_integer(json::number_integer_t v) { return value(json(v)); }
+  bool number_unsigned(json::number_unsigned_t v) { return value(json(v)); }
+  bool number_float(json::number_float_t v, const std::string&) { return value(json(v)); }
+  bool string(json::string_t& v) { return value(json(std::move(v))); }
+  bool binary(json::binary_t&) { return false; }  // not produced by JSON text
+  bool start_object(std::size_t) { return open(json::object()); }
+  bool start_array(std::size_t) { return open(json::array()); }
+  bool end_object() { return close(); }
+  bool end_array() { return close(); }
+  bool key(json::string_t& k) {
+    if (stack_.back()->contains(k)) {
+      errors_.push_back({child_pointer(paths_.back(), k), "duplicate key '" + k.substr(0, 64) +
+                                                            "'; each key may appear once in an object"});
+      failed_ = true;
+    }
+    key_ = std::move(k);
+    return true;
+  }
+  bool parse_error(std::size_t, const std::string&, const nlohmann::detail::exception& e) {
+    std::string what = e.what();
+    // Drop nlohmann's "[json.exception.parse_error.101] " prefix.
+    if (const auto pos = what.find("] "); what.rfind("[json.exception.", 0) == 0 && pos != std::string::npos)
+      what = what.substr(pos + 2);
+    // A number too large for a double is well-formed JSON: say where it is.
+    if (e.id == 406) errors_.push_back({next_pointer(), "is not a finite number: " + what});
+    else errors_.push_back({"", "not valid JSON: " + what});
+    failed_ = true;
+    return false;
+  }
+
+ private:
+  std::string next_pointer() const {
+    if (stack_.empty()) return "";
+    return stack_.back()->is_object() ? child_pointer(paths_.back(), key_)
+                                      : child_pointer(paths_.back(), stack_.back()->size());
+  }
+  // Places `v` in the current container (or as the root); returns where.
+  json* place(json&& v) {
+    if (stack_.empty()) {
+      root_ = std::move(v);
+      return &root_;
+    }
+    json& parent = *stack_.back();
+    if (parent.is_object()) {
+      json& slot = parent[key_];
+      slot = std::move(v);
+      return &slot;
+    }
+    parent.push_back(std::move(v));
+    return &parent.back();
+  }
+  bool value(json&& v) {
+    place(std::move(v));
+    return true;
+  }
+  bool open(json&& container) {
+    std::string path = next_pointer();
+    stack_.push_back(place(std::move(container)));
+    paths_.push_back(std::move(path));
+    return true;
+  }
+  bool close() {
+    stack_.pop_back();
+    paths_.pop_back();
+    return true;
+  }
+
+  json& root_;
+  std::vector<SpecError>& errors_;
+  std::vector<json*> stack_;        // open containers, innermost last
+  std::vector<std::string> paths_;  // their JSON pointers
+  std::string key_;                 // last key read in the innermost object
+  bool failed_ = false;
+};
+
+}  // namespace
+
 bool parse_json_guarded(std::string_view text, int max_depth, json& out,
                         std::vector<SpecError>& errors) {
-  // Pre-scan the nesting outside strings: nlohmann's DOM builder and
-  // destructor are fine with depth, but nothing downstream needs more than a
-  // handful of levels and a hostile document should cost O(n) and no stack.
+  // Pre-scan the nesting outside strings, so a hostile document costs O(n)
+  // and no stack before anything is built; nothing in a spec needs more
+  // than a handful of levels.
   int depth = 0;
   bool in_string = false, escaped = false;
   std::size_t line = 1;
@@ -55,17 +145,16 @@ bool parse_json_guarded(std::string_view text, int max_depth, json& out,
       depth = std::max(depth - 1, 0);
     }
   }
+  DomBuilder builder(out, errors);
+  bool ok = false;
   try {
-    out = json::parse(text.begin(), text.end());
+    ok = json::sax_parse(text.begin(), text.end(), &builder);
   } catch (const json::exception& e) {
-    std::string what = e.what();
-    // Drop nlohmann's "[json.exception.parse_error.101] " prefix.
-    if (const auto pos = what.find("] "); what.rfind("[json.exception.", 0) == 0 && pos != std::string::npos)
-      what = what.substr(pos + 2);
-    errors.push_back({"", "not valid JSON: " + what});
+    // sax_parse reports errors through the handler; this is a safety net.
+    errors.push_back({"", std::string("not valid JSON: ") + e.what()});
     return false;
   }
-  return true;
+  return ok && !builder.failed();
 }
 
 bool Range::contains(double v) const {
@@ -90,6 +179,11 @@ std::string format_number(double v) {
   char buf[32];
   const auto r = std::to_chars(buf, buf + sizeof buf, v);
   return std::string(buf, r.ptr);
+}
+
+std::string format_count(double v) {
+  if (v >= 0 && v < 1e18 && v == std::floor(v)) return std::to_string(static_cast<std::int64_t>(v));
+  return format_number(v);
 }
 
 namespace {

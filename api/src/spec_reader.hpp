@@ -50,6 +50,9 @@ struct Range {
 /// Number formatting for messages: shortest text that reads back the same.
 std::string format_number(double v);
 
+/// A count for messages: digits when integral and below 1e18 ("9000000").
+std::string format_count(double v);
+
 /// Nearest of `candidates` to `word` by edit distance (empty if none).
 std::string nearest_word(std::string_view word, std::span<const std::string_view> candidates);
 

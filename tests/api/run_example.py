@@ -1,0 +1,41 @@
+"""Runs one example job with the built `hmpm` and checks every result file.
+
+Usage: run_example.py HMPM EXAMPLE.json OUT_DIR
+`hmpm run` must exit 0 and write summary.json (status successful),
+series.json/series.csv when the spec asks for a series, and snapshots.pvd
+with .vtu files (read back with meshio) when it asks for snapshots.
+"""
+import json
+import os
+import shutil
+import subprocess
+import sys
+
+
+def main():
+    hmpm, example, out = sys.argv[1:4]
+    shutil.rmtree(out, ignore_errors=True)
+    with open(example) as f:
+        spec = json.load(f)
+    run = subprocess.run([hmpm, "run", example, "--out", out, "--threads", "2"],
+                         capture_output=True, text=True, timeout=600)
+    print(run.stdout, run.stderr, sep="\n")
+    if run.returncode != 0:
+        print(f"hmpm run exited {run.returncode}")
+        # Still check what was written: summary.json must exist even on failure.
+    output = spec.get("output", {})
+    check = [sys.executable, os.path.join(os.path.dirname(__file__), "check_results.py"), out,
+             "--status", "successful"]
+    if "series" in output:
+        check.append("--require-series")
+    if "snapshots" in output:
+        check += ["--require-snapshots", "--snapshot-fields",
+                  ",".join(output["snapshots"].get("fields", ["displacement", "velocity", "pore_pressure",
+                                                               "effective_stress", "strain", "porosity",
+                                                               "darcy_velocity", "total_stress"]))]
+    checked = subprocess.run(check)
+    return 0 if run.returncode == 0 and checked.returncode == 0 else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())

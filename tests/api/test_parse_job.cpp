@@ -1,0 +1,204 @@
+// test_parse_job.cpp — a valid spec becomes exactly the Problem it describes:
+// every field, the defaults of the contract, compiled expressions, resolved
+// particle selections, the cost estimate and the known-key table.
+#include <cmath>
+#include <limits>
+#include <variant>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "hmpm/api/job.hpp"
+#include "test_support.hpp"
+
+namespace hmpm::api {
+namespace {
+
+using testing::read_text;
+using testing::source_path;
+
+ParsedJob parse_valid(const std::string& text) {
+  ParseResult r = parse_job(text);
+  for (const auto& e : r.errors) ADD_FAILURE() << e.path << ": " << e.message;
+  EXPECT_TRUE(r.job.has_value());
+  return r.job ? std::move(*r.job) : ParsedJob{};
+}
+
+TEST(ParseJob, RoundTripOfEveryField) {
+  const ParsedJob job = parse_valid(read_text(source_path("tests/api/data/valid-2d.json")));
+  const Problem& p = job.problem;
+  EXPECT_EQ(job.name, "valid-2d");
+  EXPECT_EQ(p.dimension, 2);
+  EXPECT_EQ(p.grid.min, (Vec3{0, 0, 0}));
+  EXPECT_EQ(p.grid.max, (Vec3{1, 1, 0}));
+  EXPECT_EQ(p.grid.cells[0], 4);
+  EXPECT_EQ(p.grid.cells[1], 4);
+  EXPECT_EQ(p.shape_function, ShapeFunction::linear);
+  ASSERT_EQ(p.materials.size(), 2u);
+  // Materials are held in key order; bodies refer to them by index.
+  const Material& sand = p.materials[static_cast<std::size_t>(p.bodies.at(0).material)];
+  const Material& other = p.materials[static_cast<std::size_t>(p.bodies.at(1).material)];
+  EXPECT_EQ(sand.name, "sand");
+  EXPECT_EQ(other.name, "a/b~c");
+  EXPECT_DOUBLE_EQ(sand.density, 2650);
+  EXPECT_DOUBLE_EQ(sand.youngs_modulus, 1e7);
+  EXPECT_DOUBLE_EQ(sand.poisson_ratio, 0.3);
+  ASSERT_TRUE(std::holds_alternative<MohrCoulomb>(sand.plasticity));
+  const auto& mc = std::get<MohrCoulomb>(sand.plasticity);
+  EXPECT_DOUBLE_EQ(mc.friction_angle_deg, 30);
+  EXPECT_DOUBLE_EQ(mc.dilatancy_angle_deg, 5);
+  EXPECT_DOUBLE_EQ(mc.cohesion, 1000);
+  EXPECT_DOUBLE_EQ(mc.tensile_strength, 10);
+  ASSERT_TRUE(sand.hydraulic.has_value());
+  EXPECT_DOUBLE_EQ(sand.hydraulic->porosity, 0.3);
+  EXPECT_DOUBLE_EQ(sand.hydraulic->hydraulic_conductivity, 1e-3);
+  EXPECT_DOUBLE_EQ(sand.hydraulic->fluid_bulk_modulus, 2.2e9);
+  EXPECT_DOUBLE_EQ(sand.hydraulic->fluid_density, 1000);  // default
+  EXPECT_TRUE(std::isinf(sand.hydraulic->solid_bulk_modulus));  // default: incompressible grains
+  EXPECT_TRUE(std::holds_alternative<LinearElastic>(other.plasticity));
+  EXPECT_FALSE(other.hydraulic.has_value());
+
+  ASSERT_EQ(p.bodies.size(), 2u);
+  const Body& b0 = p.bodies[0];
+  EXPECT_EQ(b0.box.max, (Vec3{1, 0.5, 0}));
+  EXPECT_EQ(b0.particles_per_cell, 2);
+  EXPECT_EQ(p.bodies[1].particles_per_cell, 2);  // default
+  ASSERT_TRUE(b0.initial.velocity[0]);
+  EXPECT_DOUBLE_EQ(b0.initial.velocity[0]({0.3, 0.2, 0}), 0.0);
+  EXPECT_NEAR(b0.initial.velocity[1]({0.5, 0.2, 0}), 0.1, 1e-15);
+  EXPECT_NEAR(b0.initial.pore_pressure({0.1, 0.25, 0}), 250.0, 1e-12);
+  EXPECT_DOUBLE_EQ(b0.initial.effective_stress[0]({0, 0, 0}), -1000);
+  EXPECT_NEAR(b0.initial.effective_stress[1]({0, 0.25, 0}), -500, 1e-12);
+  EXPECT_FALSE(p.bodies[1].initial.pore_pressure);  // absent: zero
+
+  EXPECT_EQ(p.gravity, (Vec3{0, -9.81, 0}));
+  EXPECT_DOUBLE_EQ(p.gravity_constant, 9.81);
+  EXPECT_DOUBLE_EQ(p.local_damping, 0.05);
+
+  ASSERT_EQ(p.boundaries.size(), 3u);
+  EXPECT_FALSE(p.boundaries[0].nodes.all);
+  EXPECT_TRUE(p.boundaries[0].has_velocity);
+  EXPECT_TRUE(p.boundaries[1].velocity[0].has_value());
+  EXPECT_FALSE(p.boundaries[1].velocity[1].has_value());  // null: free
+  EXPECT_FALSE(p.boundaries[2].has_velocity);
+  ASSERT_TRUE(p.boundaries[2].pore_pressure.has_value());
+  EXPECT_DOUBLE_EQ((*p.boundaries[2].pore_pressure)(2.0), 200.0);
+
+  ASSERT_EQ(p.tractions.size(), 1u);
+  EXPECT_EQ(p.tractions[0].axis, 1);
+  EXPECT_EQ(p.tractions[0].side, +1);
+  EXPECT_DOUBLE_EQ(p.tractions[0].traction[1](0.5), -500.0);
+  EXPECT_DOUBLE_EQ(p.tractions[0].traction[1](3.0), -1000.0);
+
+  EXPECT_DOUBLE_EQ(p.time.end, 0.01);
+  EXPECT_FALSE(p.time.dt.has_value());
+  EXPECT_DOUBLE_EQ(p.time.courant, 0.4);
+
+  ASSERT_EQ(p.output.series_particles.size(), 2u);
+  EXPECT_EQ(p.output.series_particles[0], 0);
+  EXPECT_EQ(p.output.series_particles[1], nearest_particle(p, {0.5, 0.25, 0}));
+  EXPECT_EQ(p.output.series_fields,
+            (std::vector<Field>{Field::displacement, Field::pore_pressure, Field::effective_stress}));
+  EXPECT_DOUBLE_EQ(p.output.series_interval, 0.001);
+  EXPECT_DOUBLE_EQ(p.output.snapshot_interval, 0.005);
+  // position is added: it is the VTU Points.
+  EXPECT_EQ(p.output.snapshot_fields, (std::vector<Field>{Field::position, Field::velocity}));
+
+  const CostEstimate& c = job.cost;
+  EXPECT_EQ(c.particles, 48);  // 8 cells * 4 + 4 cells * 4
+  EXPECT_EQ(c.cells, 16);
+  EXPECT_EQ(c.nodes, 25);
+  EXPECT_DOUBLE_EQ(c.dt, stable_step(p).chosen);
+  EXPECT_EQ(c.steps, static_cast<std::int64_t>(std::ceil(0.01 / c.dt - 1e-9)));
+  EXPECT_EQ(c.particle_steps, 48 * c.steps);
+  EXPECT_EQ(c.series_rows, 11);
+  EXPECT_EQ(c.snapshots, 3);
+  EXPECT_GT(c.memory_bytes, 48 * 400);
+  EXPECT_GT(c.output_bytes, 0);
+}
+
+TEST(ParseJob, DefaultsOfTheContract) {
+  const ParsedJob job = parse_valid(R"json({"dimension": 1, "grid": {"min": [0], "max": [1], "cells": [10]},
+    "materials": {"m": {"model": "linear_elastic", "density": 1, "youngs_modulus": 1, "poisson_ratio": 0}},
+    "bodies": [{"material": "m", "box": {"min": [0], "max": [1]}}], "time": {"end": 1}})json");
+  const Problem& p = job.problem;
+  EXPECT_EQ(job.name, "job");
+  EXPECT_EQ(p.shape_function, ShapeFunction::linear);
+  EXPECT_EQ(p.bodies[0].particles_per_cell, 2);
+  EXPECT_EQ(p.gravity, (Vec3{0, 0, 0}));
+  EXPECT_TRUE(p.boundaries.empty());
+  EXPECT_TRUE(p.tractions.empty());
+  EXPECT_DOUBLE_EQ(p.time.courant, 0.5);
+  EXPECT_FALSE(p.time.dt.has_value());
+  EXPECT_DOUBLE_EQ(p.gravity_constant, 9.81);
+  EXPECT_DOUBLE_EQ(p.local_damping, 0.0);
+  EXPECT_TRUE(p.output.series_particles.empty());
+  EXPECT_DOUBLE_EQ(p.output.snapshot_interval, 0.0);
+  EXPECT_EQ(job.cost.particles, 20);
+  EXPECT_EQ(job.cost.snapshots, 0);
+  EXPECT_EQ(job.cost.series_rows, 0);
+}
+
+TEST(ParseJob, ShapeFunctionsModelsAndAllSelections) {
+  const ParsedJob job = parse_valid(R"json({"dimension": 3, "shape_function": "bspline",
+    "grid": {"min": [0, 0, 0], "max": [1, 1, 1], "cells": [2, 2, 2]},
+    "materials": {"m": {"model": "drucker_prager", "density": 1, "youngs_modulus": 1, "poisson_ratio": 0,
+                        "friction_angle": 0, "dilatancy_angle": 0, "cohesion": 5}},
+    "bodies": [{"material": "m", "box": {"min": [0, 0, 0], "max": [1, 1, 1]}, "particles_per_cell": 1}],
+    "boundaries": [{"nodes": "all", "velocity": [null, null, "sin(t)"]}],
+    "tractions": [{"particles": "all", "face": "z-", "traction": [1, 2, 3]}],
+    "time": {"end": 1, "dt": 0.01}})json");
+  const Problem& p = job.problem;
+  EXPECT_EQ(p.shape_function, ShapeFunction::bspline);
+  ASSERT_TRUE(std::holds_alternative<DruckerPrager>(p.materials[0].plasticity));
+  EXPECT_DOUBLE_EQ(std::get<DruckerPrager>(p.materials[0].plasticity).cohesion, 5);
+  EXPECT_TRUE(p.boundaries[0].nodes.all);
+  EXPECT_TRUE(p.boundaries[0].has_velocity);
+  EXPECT_NEAR((*p.boundaries[0].velocity[2])(0.5), std::sin(0.5), 1e-15);
+  EXPECT_EQ(p.tractions[0].axis, 2);
+  EXPECT_EQ(p.tractions[0].side, -1);
+  EXPECT_EQ(p.tractions[0].particles.max, (Vec3{1, 1, 1}));
+  ASSERT_TRUE(p.time.dt.has_value());
+  EXPECT_DOUBLE_EQ(*p.time.dt, 0.01);
+  EXPECT_EQ(job.cost.steps, 100);
+}
+
+TEST(ParseJob, EveryExampleIsValid) {
+  for (const char* name : {"bar-vibration", "darcy-flow", "terzaghi"}) {
+    SCOPED_TRACE(name);
+    const ParseResult r = parse_job(read_text(source_path(std::string("examples/") + name + ".json")));
+    for (const auto& e : r.errors) ADD_FAILURE() << e.path << ": " << e.message;
+    ASSERT_TRUE(r.job.has_value());
+    EXPECT_EQ(r.job->name, name);
+  }
+}
+
+TEST(ParseJob, BarVibrationMatchesTheContract) {
+  const ParsedJob job = parse_valid(read_text(source_path("examples/bar-vibration.json")));
+  EXPECT_EQ(job.cost.particles, 13);
+  EXPECT_EQ(job.cost.nodes, 14);
+  EXPECT_EQ(job.cost.steps, 2530);
+  EXPECT_EQ(job.problem.output.series_particles, (std::vector<std::int64_t>{0, 3, 6, 12}));
+  const Vec3 x{0.5, 0, 0};
+  EXPECT_NEAR(job.problem.bodies[0].initial.velocity[0](x), 0.1 * std::sin(M_PI / 4), 1e-15);
+}
+
+TEST(ParseJob, KnownKeysTableCoversTheTopLevel) {
+  const auto& table = spec_object_keys();
+  ASSERT_FALSE(table.empty());
+  EXPECT_EQ(table.front().location, "");
+  const auto& top = table.front().keys;
+  for (const char* key : {"name", "dimension", "grid", "materials", "bodies", "time", "output", "description"})
+    EXPECT_NE(std::find(top.begin(), top.end(), key), top.end()) << key;
+}
+
+TEST(ParseJob, MediaTypes) {
+  EXPECT_EQ(media_type_for("summary.json"), "application/json");
+  EXPECT_EQ(media_type_for("series.csv"), "text/csv");
+  EXPECT_EQ(media_type_for("snapshots.pvd"), "application/xml");
+  EXPECT_EQ(media_type_for("snapshot_0001.vtu"), "application/xml");
+  EXPECT_EQ(media_type_for("x.bin"), "application/octet-stream");
+}
+
+}  // namespace
+}  // namespace hmpm::api

@@ -1,0 +1,172 @@
+// test_writers.cpp — the result files from synthetic data with known values:
+// series.json layout of the contract, series.csv header and rows, VTU and PVD
+// read back by an independent reader (meshio, via check_results.py), atomic
+// writes, and run_job's summary on success and on failure.
+#include <cmath>
+#include <filesystem>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "hmpm/api/job.hpp"
+#include "test_support.hpp"
+#include "writers.hpp"
+
+namespace hmpm::api {
+namespace {
+
+using nlohmann::json;
+namespace fs = std::filesystem;
+
+// 2D series: particles 4 and 9, displacement (2 comps), pore_pressure (1),
+// strain (6); value = 1000 * row + 100 * particle slot + 10 * field + component.
+Series synthetic_series() {
+  Series s;
+  s.dimension = 2;
+  s.time = {0.0, 0.5, 1.0};
+  s.particles = {4, 9};
+  s.initial_positions = {Vec3{0.25, 0.5, 0}, Vec3{0.75, 0.125, 0}};
+  s.fields = {Field::displacement, Field::pore_pressure, Field::strain};
+  for (std::size_t f = 0; f < s.fields.size(); ++f) {
+    const int nc = field_components(s.fields[f], 2);
+    std::vector<double> v;
+    for (std::size_t r = 0; r < s.time.size(); ++r)
+      for (std::size_t p = 0; p < s.particles.size(); ++p)
+        for (int c = 0; c < nc; ++c) v.push_back(1000.0 * r + 100.0 * p + 10.0 * f + c);
+    s.values.push_back(v);
+  }
+  return s;
+}
+
+Snapshot synthetic_snapshot(int index, std::int64_t n) {
+  Snapshot s;
+  s.index = index;
+  s.time = 0.25 * index;
+  s.dimension = 2;
+  s.particles = n;
+  s.fields = {Field::position, Field::velocity, Field::pore_pressure, Field::effective_stress};
+  for (std::int64_t i = 0; i < n; ++i) {
+    const double x = static_cast<double>(i);
+    s.position.insert(s.position.end(), {x, 2 * x, 0});
+    s.velocity.insert(s.velocity.end(), {-x, 0.5, 0});
+    s.pore_pressure.push_back(100 + x);
+    for (int k = 0; k < 6; ++k) s.effective_stress.push_back(-x * (k + 1));
+    s.volume.push_back(0.01);
+    s.material.push_back(static_cast<int>(i % 2));
+  }
+  return s;
+}
+
+TEST(Writers, SeriesJsonHasTheContractLayout) {
+  testing::TempDir dir;
+  write_series_json(dir.path() / "series.json", synthetic_series());
+  const json j = json::parse(testing::read_text(dir.path() / "series.json"));
+  EXPECT_EQ(j["time"], json({0.0, 0.5, 1.0}));
+  ASSERT_EQ(j["particles"].size(), 2u);
+  const json& p1 = j["particles"][1];
+  EXPECT_EQ(p1["index"], 9);
+  EXPECT_EQ(p1["initial_position"], json({0.75, 0.125}));
+  // Vectors: arrays of dim components; scalars: numbers; tensors: 6 (Voigt).
+  EXPECT_EQ(p1["displacement"][2], json({2100.0, 2101.0}));
+  EXPECT_EQ(p1["pore_pressure"], json({110.0, 1110.0, 2110.0}));
+  ASSERT_EQ(p1["strain"][0].size(), 6u);
+  EXPECT_EQ(p1["strain"][0][5], 125.0);
+  EXPECT_FALSE(fs::exists(dir.path() / "series.json.tmp"));
+}
+
+TEST(Writers, SeriesCsvMatchesJson) {
+  testing::TempDir dir;
+  write_series_csv(dir.path() / "series.csv", synthetic_series());
+  const std::string csv = testing::read_text(dir.path() / "series.csv");
+  const std::string header = csv.substr(0, csv.find('\n'));
+  EXPECT_EQ(header.rfind("time,p4_displacement_x,p4_displacement_y,p4_pore_pressure,p4_strain_xx,", 0), 0u)
+      << header;
+  EXPECT_NE(header.find(",p9_strain_zx"), std::string::npos);
+  EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 4);  // header + 3 rows
+  EXPECT_NE(csv.find("\n0.5,1000,1001,1010,1020,"), std::string::npos) << csv;
+}
+
+TEST(Writers, NonFiniteValuesStayReadable) {
+  Series s = synthetic_series();
+  s.values[1][0] = std::nan("");
+  s.values[1][1] = std::numeric_limits<double>::infinity();
+  testing::TempDir dir;
+  write_series_json(dir.path() / "series.json", s);
+  write_series_csv(dir.path() / "series.csv", s);
+  const json j = json::parse(testing::read_text(dir.path() / "series.json"));  // null, still JSON
+  EXPECT_TRUE(j["particles"][0]["pore_pressure"][0].is_null());
+  EXPECT_NE(testing::read_text(dir.path() / "series.csv").find(",nan,"), std::string::npos);
+}
+
+TEST(Writers, SnapshotsReadBackWithMeshio) {
+  testing::TempDir dir;
+  std::vector<std::pair<double, std::string>> entries;
+  for (int i = 0; i < 3; ++i) {
+    const Snapshot s = synthetic_snapshot(i, 7);
+    write_snapshot_vtu(dir.path() / snapshot_file_name(i), s);
+    entries.emplace_back(s.time, snapshot_file_name(i));
+  }
+  write_pvd(dir.path() / "snapshots.pvd", entries);
+  RunResult run;
+  run.status = RunStatus::successful;
+  run.particles = 7;
+  write_summary(dir.path() / "summary.json", "synthetic", run, CostEstimate{}, {});
+  EXPECT_EQ(snapshot_file_name(12), "snapshot_0012.vtu");
+  const std::string py = testing::python_exe(dir.path());
+  const auto r = testing::run_command(
+      "bash -c " + std::string("\"") + py + " '" + testing::source_path("tests/api/check_results.py").string() +
+          "' '" + dir.path().string() + "' --particles 7 --require-snapshots --snapshot-fields velocity,pore_pressure,effective_stress\"",
+      fs::temp_directory_path());
+  EXPECT_EQ(r.exit_code, 0) << r.out << r.err;
+  // Exact values through meshio.
+  const std::string probe = py + " -c \"import meshio; m = meshio.read('" + (dir.path() / "snapshot_0002.vtu").string() +
+                            "'); print(m.points[3].tolist(), m.point_data['effective_stress'][3].tolist(), "
+                            "m.point_data['material'].tolist(), m.point_data['pore_pressure'][6])\"";
+  const auto v = testing::run_command(probe, fs::temp_directory_path());
+  EXPECT_EQ(v.out, "[3.0, 6.0, 0.0] [-3.0, -6.0, -9.0, -12.0, -15.0, -18.0] [0, 1, 0, 1, 0, 1, 0] 106.0\n")
+      << v.err;
+}
+
+TEST(Writers, EmptySnapshotIsStillAValidFile) {
+  testing::TempDir dir;
+  write_snapshot_vtu(dir.path() / "snapshot_0000.vtu", synthetic_snapshot(0, 0));
+  const std::string text = testing::read_text(dir.path() / "snapshot_0000.vtu");
+  EXPECT_NE(text.find("NumberOfPoints=\"0\""), std::string::npos);
+}
+
+TEST(Writers, UnwritableDirectoryThrows) {
+  EXPECT_THROW(write_pvd("/nonexistent-dir/x/snapshots.pvd", {}), std::runtime_error);
+}
+
+TEST(RunJob, WritesEveryRequestedFileAndASummary) {
+  const ParseResult parsed = parse_job(testing::read_text(testing::source_path("tests/api/data/valid-2d.json")));
+  ASSERT_TRUE(parsed.job);
+  testing::TempDir dir;
+  const JobOutcome out = run_job(*parsed.job, dir.path() / "results");
+  for (const std::string& f : out.files) EXPECT_TRUE(fs::exists(dir.path() / "results" / f)) << f;
+  EXPECT_NE(std::find(out.files.begin(), out.files.end(), "summary.json"), out.files.end());
+  const json summary = json::parse(testing::read_text(dir.path() / "results" / "summary.json"));
+  for (const char* key : {"status", "message", "steps", "end_time", "dt", "particles", "nodes", "solve_seconds",
+                          "particle_steps_per_second", "warnings", "cost", "name", "hmpm_version"})
+    EXPECT_TRUE(summary.contains(key)) << key;
+  EXPECT_EQ(summary["name"], "valid-2d");
+  EXPECT_EQ(summary["cost"]["particles"], 48);
+  EXPECT_EQ(summary["status"], "successful") << summary["message"];
+  EXPECT_NE(std::find(out.files.begin(), out.files.end(), "series.json"), out.files.end());
+  EXPECT_NE(std::find(out.files.begin(), out.files.end(), "snapshots.pvd"), out.files.end());
+}
+
+TEST(RunJob, FailedWriteStillLeavesASummaryAndThrows) {
+  const ParseResult parsed = parse_job(testing::read_text(testing::source_path("examples/bar-vibration.json")));
+  ASSERT_TRUE(parsed.job);
+  testing::TempDir dir;
+  // A directory where the first snapshot file should go makes its rename fail.
+  fs::create_directories(dir.path() / "snapshot_0000.vtu" / "blocker");
+  EXPECT_THROW(run_job(*parsed.job, dir.path()), std::runtime_error);
+  const json summary = json::parse(testing::read_text(dir.path() / "summary.json"));
+  EXPECT_EQ(summary["status"], "failed");
+  EXPECT_NE(summary["message"].get<std::string>().find("could not write"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace hmpm::api
