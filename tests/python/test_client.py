@@ -72,6 +72,9 @@ class ClientTest(LiveServerCase):
         self.assertEqual(sorted(p["index"] for p in series["particles"]), [0, 6, 12])
         for p in series["particles"]:
             self.assertEqual(len(p["displacement"]), len(times))
+            self.assertEqual(len(p["velocity"]), len(times))
+            self.assertIsInstance(p["velocity"][0], list,
+                                  "CONTRACT.md: vectors are arrays of components, also in 1D ([[ux], ...])")
             self.assertEqual(len(p["velocity"][0]), 1)
 
     def test_results_not_ready(self):
@@ -139,7 +142,7 @@ class ClientTest(LiveServerCase):
         doc = job.wait(progress=True, timeout=JOB_TIMEOUT_S, file=out)
         self.assertEqual(doc["status"], "successful")
         text = out.getvalue()
-        self.assertIn(job.id, text)
+        self.assertIn(job.id[:8], text)
         self.assertIn("100.0%", text)
         self.assertIn("successful", text.splitlines()[-1])
 

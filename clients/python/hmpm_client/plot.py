@@ -4,7 +4,7 @@ matplotlib is optional: the client itself uses the standard library only, and
 `plot_series` raises `MatplotlibMissing` (with the Debian package to install)
 when it cannot be imported. Scalars (pore_pressure, porosity) give one axes
 with a line per particle; vectors and Voigt tensors give one axes per
-component.
+component that is not zero throughout.
 """
 
 from __future__ import annotations
@@ -78,15 +78,22 @@ def plot_series(series: Dict[str, Any], field: str, out: Path, title: Optional[s
 
     first = particles[0][field]
     ncomp = len(first[0]) if first and isinstance(first[0], list) else 0
-    names = component_names(ncomp) if ncomp else [""]
-    fig, axes = plt.subplots(len(names), 1, sharex=True, squeeze=False,
-                             figsize=(7.5, 2.2 + 2.0 * len(names)))
+    names = list(component_names(ncomp)) if ncomp else [""]
+    columns = list(range(len(names)))
+    if ncomp > 1:
+        # Leave out components that are zero throughout (e.g. the shear
+        # stresses of a 1D column); keep at least one.
+        nonzero = [c for c in columns if any(v[c] != 0 for p in particles for v in p[field])]
+        columns = nonzero or columns[:1]
+    fig, axes = plt.subplots(len(columns), 1, sharex=True, squeeze=False,
+                             figsize=(7.5, 2.2 + 2.0 * len(columns)))
     unit = UNITS.get(field, "")
-    for row, comp in enumerate(names):
+    for row, col in enumerate(columns):
+        comp = names[col]
         ax = axes[row][0]
         for p in particles:
             values = p[field]
-            ys = [v[row] if isinstance(v, list) else v for v in values] if ncomp else values
+            ys = [v[col] if isinstance(v, list) else v for v in values] if ncomp else values
             n = min(len(times), len(ys))
             ax.plot(times[:n], ys[:n], label=_label(p))
         ylabel = field + (f" {comp}" if comp else "") + (f" [{unit}]" if unit else "")

@@ -14,6 +14,7 @@ the job started running; it is never taken from the server's clock.
 
 from __future__ import annotations
 
+import shutil
 import sys
 import time
 from typing import Any, Dict, Optional, TextIO
@@ -85,7 +86,7 @@ class ProgressBar:
         p = min(max(p, 0.0), 100.0)
         filled = int(round(self.width * p / 100.0))
         bar = "#" * filled + "-" * (self.width - filled)
-        parts = [f"{self.job_id} {status:<10}", f"[{bar}]", f"{p:5.1f}%"]
+        parts = [f"{self.job_id[:8]} {status:<10}", f"[{bar}]", f"{p:5.1f}%"]
         sim = _number(doc, _SIM_TIME_KEYS)
         end = _number(doc, _END_TIME_KEYS)
         cost = doc.get("cost")
@@ -120,6 +121,8 @@ class ProgressBar:
             self._start = (time.monotonic(), p)
         line = self.render(doc)
         if self.tty:
+            # Never wrap: a wrapped line cannot be redrawn with a carriage return.
+            line = line[: max(20, shutil.get_terminal_size((100, 24)).columns - 1)]
             pad = max(0, self._last_line_len - len(line))
             self.file.write("\r" + line + " " * pad)
             self._last_line_len = len(line)
