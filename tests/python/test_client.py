@@ -73,9 +73,15 @@ class ClientTest(LiveServerCase):
         for p in series["particles"]:
             self.assertEqual(len(p["displacement"]), len(times))
             self.assertEqual(len(p["velocity"]), len(times))
-            self.assertIsInstance(p["velocity"][0], list,
-                                  "CONTRACT.md: vectors are arrays of components, also in 1D ([[ux], ...])")
-            self.assertEqual(len(p["velocity"][0]), 1)
+
+    def test_series_vectors_are_component_arrays(self):
+        # CONTRACT.md, series.json: vectors as arrays of components, also in
+        # 1D: "displacement": [[ux], ...].
+        series = self.run_small_job().series()
+        for p in series["particles"]:
+            for field in ("displacement", "velocity"):
+                self.assertIsInstance(p[field][0], list, f"{field} rows must be [ux], not a bare number")
+                self.assertEqual(len(p[field][0]), 1)
 
     def test_results_not_ready(self):
         job = self.client.submit(long_spec())

@@ -80,7 +80,7 @@ class CurlWalkthroughTest(unittest.TestCase):
         self.assertIn("successful 100", out, report)
         self.assertRegex(out, r"series\.json: OK", report)
         self.assertNotIn("FAILED", out, report)
-        self.assertIn("/materials/bar/youngs_modulus", out, report)
+        self.assertIn("/materials/clay/youngs_modulus", out, report)
         self.assertIn("/time", out, report)
         self.assertIn("dismissed", out, report)
         for name in ("summary.json", "series.json", "series.csv", "snapshots.pvd"):
