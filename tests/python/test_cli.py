@@ -46,7 +46,7 @@ class CliTest(LiveServerCase):
             self.assertEqual(hashlib.sha256(data).hexdigest(), f["sha256"].lower(), f["name"])
         # The progress bar went to stderr: percent, final state.
         self.assertIn("%", r.stderr)
-        self.assertIn("100.0%", r.stderr)
+        self.assertIn("100%", r.stderr)
         self.assertIn("successful", r.stderr)
 
     def test_invalid_spec_exits_non_zero_with_paths(self):

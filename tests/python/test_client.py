@@ -149,7 +149,7 @@ class ClientTest(LiveServerCase):
         self.assertEqual(doc["status"], "successful")
         text = out.getvalue()
         self.assertIn(job.id[:8], text)
-        self.assertIn("100.0%", text)
+        self.assertIn("100%", text)
         self.assertIn("successful", text.splitlines()[-1])
 
     def test_wait_falls_back_to_polling(self):

@@ -57,11 +57,11 @@ class ProgressTest(unittest.TestCase):
         bar.update(doc)
         bar._start = (bar._start[0] - 10.0, 0.0)  # pretend 10 s have passed
         line = bar.render(dict(doc, progress=50))
-        self.assertIn("50.0%", line)
+        self.assertIn(" 50%", line)
         self.assertIn("t=1/2 s", line)
         self.assertRegex(line, r"ETA (9|10|11)s")
         bar.finish({"status": "successful", "progress": 100})
-        self.assertIn("100.0%", out.getvalue().splitlines()[-1])
+        self.assertIn("100%", out.getvalue().splitlines()[-1])
         self.assertIn("successful", out.getvalue().splitlines()[-1])
 
     def test_non_tty_output_is_short(self):

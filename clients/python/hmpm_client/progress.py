@@ -52,7 +52,7 @@ def format_sim_time(t: float) -> str:
 class ProgressBar:
     """Draws the progress of one job on `file` (default: stderr)."""
 
-    width = 24
+    width = 20
 
     def __init__(self, job_id: str, file: Optional[TextIO] = None, end_time: Optional[float] = None):
         self.job_id = job_id
@@ -86,7 +86,7 @@ class ProgressBar:
         p = min(max(p, 0.0), 100.0)
         filled = int(round(self.width * p / 100.0))
         bar = "#" * filled + "-" * (self.width - filled)
-        parts = [f"{self.job_id[:8]} {status:<10}", f"[{bar}]", f"{p:5.1f}%"]
+        parts = [f"{self.job_id[:8]} {status:<10}", f"[{bar}]", f"{p:3.0f}%"]
         sim = _number(doc, _SIM_TIME_KEYS)
         end = _number(doc, _END_TIME_KEYS)
         cost = doc.get("cost")
