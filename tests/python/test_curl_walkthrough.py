@@ -51,6 +51,8 @@ def run_blocks(blocks: List[Tuple[str, str]], cwd: Path, env: dict) -> subproces
         script.append(code)
     full_env = dict(os.environ)
     full_env.pop("HMPM_TOKEN", None)
+    # curl would send even loopback requests through a configured proxy.
+    full_env["no_proxy"] = full_env["NO_PROXY"] = "127.0.0.1,localhost"
     full_env.update(env)
     return subprocess.run(["bash", "-c", "\n".join(script)], cwd=str(cwd), env=full_env,
                           capture_output=True, text=True, timeout=RUN_TIMEOUT_S)

@@ -89,7 +89,7 @@ def _print_json(doc: Any) -> None:
 
 def _status_line(doc: Dict[str, Any]) -> str:
     progress = doc.get("progress")
-    pct = f"{float(progress):5.1f}%" if isinstance(progress, (int, float)) else "    ?"
+    pct = f"{float(progress):3.0f}%" if isinstance(progress, (int, float)) else "  ?%"
     msg = str(doc.get("message") or "")
     return f"{doc.get('jobID', '?')}  {str(doc.get('status', '?')):<10} {pct}  {doc.get('created', '')}  {msg}"
 

@@ -64,6 +64,13 @@ class Client:
         self.url = url.rstrip("/")
         self.token = token if token is not None else (os.environ.get("HMPM_TOKEN") or None)
         self.timeout = timeout
+        # A service on this machine is reached directly even when
+        # http_proxy/https_proxy are set; anything else follows the
+        # environment's proxy settings as urllib does by default.
+        host = (urllib.parse.urlsplit(self.url).hostname or "").lower()
+        loopback = host in ("localhost", "::1") or host.startswith("127.")
+        self._opener = urllib.request.build_opener(urllib.request.ProxyHandler({}) if loopback else
+                                                   urllib.request.ProxyHandler())
 
     def __repr__(self) -> str:
         return f"Client({self.url!r})"
@@ -96,7 +103,7 @@ class Client:
         hdrs.update(headers or {})
         req = urllib.request.Request(url, data=body, method=method, headers=hdrs)
         try:
-            return urllib.request.urlopen(req, timeout=self.timeout if timeout is None else timeout)
+            return self._opener.open(req, timeout=self.timeout if timeout is None else timeout)
         except urllib.error.HTTPError as e:
             try:
                 raw = e.read()
