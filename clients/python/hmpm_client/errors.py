@@ -72,6 +72,9 @@ class HmpmError(Exception):
         detail = self.detail
         if detail and detail != self.title:
             head = f"{head}: {detail}"
+        retry = self.problem.get("retry_after")
+        if retry is not None:
+            head = f"{head} (retry after {retry} s)"
         lines = [head]
         for e in self.errors:
             path = e["path"] or "/"
