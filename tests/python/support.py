@@ -127,11 +127,13 @@ class LiveServerCase(unittest.TestCase):
 
     server_token: Optional[str] = None
     server_workers = 2
+    server_args: List[str] = []
     server: ServerProcess
 
     @classmethod
     def setUpClass(cls):
-        cls.server = ServerProcess(token=cls.server_token, workers=cls.server_workers).start()
+        cls.server = ServerProcess(token=cls.server_token, workers=cls.server_workers,
+                                   extra=cls.server_args).start()
 
     @classmethod
     def tearDownClass(cls):

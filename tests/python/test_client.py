@@ -209,5 +209,15 @@ class TokenTest(LiveServerCase):
         self.assertIsInstance(client.jobs(), list)
 
 
+class QueueFullTest(LiveServerCase):
+    server_args = ["--max-queue", "0"]
+
+    def test_queue_full_is_an_error_with_retry_after(self):
+        with self.assertRaises(HmpmError) as ctx:
+            Client(self.server.url).submit(bar_spec())
+        self.assertEqual(ctx.exception.status, 503)
+        self.assertIn("retry after", str(ctx.exception))
+
+
 if __name__ == "__main__":
     unittest.main()
