@@ -66,7 +66,7 @@ constexpr Field kFields[] = {Field::position,       Field::displacement,     Fie
                              Field::strain,         Field::porosity,         Field::total_stress};
 constexpr std::string_view kAxisNames[] = {"x", "y", "z"};
 constexpr int kMaxParticlesPerCell = 10;
-// Work bound for resolving {"near": ...} selections (selections x particles).
+// Work bound for checks that visit every particle per selection.
 constexpr double kMaxNearWork = 2e8;
 
 std::string quoted_list(const std::vector<std::string>& words) {
@@ -111,6 +111,18 @@ std::int64_t nodes_inside(const Grid& grid, int axis, double lo, double hi) {
   return b >= a ? static_cast<std::int64_t>(b - a) + 1 : 0;
 }
 
+// A formula (not a plain number) read from the spec, checked for finite
+// values once the particles are known.
+struct PositionFormula {
+  std::size_t body;
+  std::string path;
+  FieldOfPosition f;
+};
+struct TimeFormula {
+  std::string path;
+  FieldOfTime f;
+};
+
 struct PendingNear {
   std::size_t slot;  // index into series_particles
   Vec3 at;
@@ -146,6 +158,7 @@ class JobParser {
   bool check_particle_budget();
   void resolve_near();
   void check_traction_selections();
+  void check_formulas_are_finite();
   void check_limits();
   std::string pointer_for(const std::string& where) const;
 
@@ -157,6 +170,8 @@ class JobParser {
   bool grid_ok_ = false;  // grid valid: boxes can be checked against it
   std::map<std::string, int> material_index_;
   std::vector<PendingNear> near_;
+  std::vector<PositionFormula> position_formulas_;
+  std::vector<TimeFormula> time_formulas_;
   std::vector<std::string> traction_paths_;
   bool any_pore_pressure_bc_ = false;
   std::string first_pore_pressure_bc_;
@@ -400,7 +415,10 @@ std::optional<Box> JobParser::parse_selection(const json& j, const std::string& 
 FieldOfPosition JobParser::position_value(const json& j, const std::string& path) {
   if (j.is_string()) {
     std::string error;
-    if (auto f = compile_field_of_position(j.get_ref<const std::string&>(), error)) return *f;
+    if (auto f = compile_field_of_position(j.get_ref<const std::string&>(), error)) {
+      position_formulas_.push_back({p_.bodies.size(), path, *f});
+      return *f;
+    }
     r_.error(path, error);
     return {};
   }
@@ -415,7 +433,10 @@ FieldOfPosition JobParser::position_value(const json& j, const std::string& path
 std::optional<FieldOfTime> JobParser::time_value(const json& j, const std::string& path) {
   if (j.is_string()) {
     std::string error;
-    if (auto f = compile_field_of_time(j.get_ref<const std::string&>(), error)) return f;
+    if (auto f = compile_field_of_time(j.get_ref<const std::string&>(), error)) {
+      time_formulas_.push_back({path, *f});
+      return f;
+    }
     r_.error(path, error);
     return std::nullopt;
   }
@@ -679,6 +700,7 @@ void JobParser::check_whole_problem() {
   for (const ProblemIssue& issue : check_problem(p_)) r_.error(pointer_for(issue.where), issue.message);
   if (r_.error_count() > 0) return;
   check_traction_selections();
+  check_formulas_are_finite();
   if (r_.error_count() > 0) return;
   check_limits();
 }
@@ -700,7 +722,10 @@ void JobParser::resolve_near() {
 }
 
 void JobParser::check_traction_selections() {
-  if (p_.tractions.empty()) return;
+  // A convenience check, skipped when it would cost more than a moment.
+  if (p_.tractions.empty() ||
+      static_cast<double>(p_.tractions.size()) * static_cast<double>(count_particles(p_)) > kMaxNearWork)
+    return;
   const std::vector<Vec3> positions = initial_positions(p_);
   for (std::size_t k = 0; k < p_.tractions.size(); ++k) {
     const Box& box = p_.tractions[k].particles;
@@ -712,6 +737,58 @@ void JobParser::check_traction_selections() {
     if (!any)
       r_.error(traction_paths_[k], "selects no particle; particles sit at sub-cell centres, e.g. the "
                                    "top row of a body is half a particle spacing below its top face");
+  }
+}
+
+void JobParser::check_formulas_are_finite() {
+  // Time functions: at up to 1001 instants over [0, end], about a million
+  // evaluations in all.
+  const int intervals = static_cast<int>(
+      std::clamp(1e6 / static_cast<double>(std::max<std::size_t>(time_formulas_.size(), 1)), 1.0, 1000.0));
+  for (const TimeFormula& tf : time_formulas_) {
+    for (int k = 0; k <= intervals; ++k) {
+      const double t = p_.time.end * k / intervals;
+      const double v = tf.f(t);
+      if (!std::isfinite(v)) {
+        r_.error(tf.path, "the formula gives " + format_number(v) + " at t = " + format_number(t) + " s");
+        break;
+      }
+    }
+  }
+  if (position_formulas_.empty()) return;
+  // Initial fields: at every particle of the body, or a regular sample of
+  // about a million evaluations in all when the bodies are large.
+  std::vector<std::vector<Vec3>> positions(p_.bodies.size());
+  double evaluations = 0;
+  for (const PositionFormula& pf : position_formulas_) {
+    if (pf.body >= p_.bodies.size()) continue;
+    if (positions[pf.body].empty()) {
+      Problem one;
+      one.dimension = p_.dimension;
+      one.grid = p_.grid;
+      Body b;
+      b.box = p_.bodies[pf.body].box;
+      b.particles_per_cell = p_.bodies[pf.body].particles_per_cell;
+      one.bodies.push_back(b);
+      positions[pf.body] = initial_positions(one);
+    }
+    evaluations += static_cast<double>(positions[pf.body].size());
+  }
+  const std::size_t stride = static_cast<std::size_t>(std::max(1.0, std::ceil(evaluations / 1e6)));
+  for (const PositionFormula& pf : position_formulas_) {
+    if (pf.body >= p_.bodies.size()) continue;
+    const std::vector<Vec3>& xs = positions[pf.body];
+    for (std::size_t i = 0; i < xs.size(); i += stride) {
+      const double v = pf.f(xs[i]);
+      if (!std::isfinite(v)) {
+        std::string at = "x = " + format_number(xs[i][0]);
+        if (dim_ > 1) at += ", y = " + format_number(xs[i][1]);
+        if (dim_ > 2) at += ", z = " + format_number(xs[i][2]);
+        r_.error(pf.path, "the formula gives " + format_number(v) + " at a particle of body " +
+                              std::to_string(pf.body) + " (" + at + ")");
+        break;
+      }
+    }
   }
 }
 
