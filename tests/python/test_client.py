@@ -134,6 +134,11 @@ class ClientTest(LiveServerCase):
         self.assertTrue(successful)
         self.assertTrue(all(d["status"] == "successful" for d in successful))
         self.assertEqual(len(self.client.jobs(limit=1)), 1)
+        finished = self.client.jobs(status=["successful", "failed"], limit=1000)
+        self.assertIn(done.id, [d["jobID"] for d in finished])
+        with self.assertRaises(HmpmError) as ctx:
+            self.client.jobs(status="no-such-state")
+        self.assertEqual(ctx.exception.status, 400)
 
     def test_idempotency_key_returns_the_same_job(self):
         key = str(uuid.uuid4())

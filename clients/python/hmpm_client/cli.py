@@ -62,7 +62,8 @@ def _parser() -> argparse.ArgumentParser:
     s.add_argument("--quiet", "-q", action="store_true", help="no progress bar")
 
     s = sub.add_parser("list", help="list jobs")
-    s.add_argument("--status", choices=["accepted", "running", "successful", "failed", "dismissed"])
+    s.add_argument("--status", metavar="S[,S...]",
+                   help="only these states: accepted, running, successful, failed, dismissed")
     s.add_argument("--limit", type=int)
     s.add_argument("--json", action="store_true", help="print the status documents as JSON")
 

@@ -24,7 +24,7 @@ import urllib.error
 import urllib.parse
 import urllib.request
 from pathlib import Path
-from typing import Any, Dict, List, Optional, TextIO, Union
+from typing import Any, Dict, List, Optional, Sequence, TextIO, Union
 
 from .errors import HmpmError
 from .events import read_events
@@ -177,11 +177,13 @@ class Client:
         """A handle on an existing job (no request is made)."""
         return Job(self, job_id)
 
-    def jobs(self, status: Optional[str] = None, limit: Optional[int] = None) -> List[Dict[str, Any]]:
-        """`GET /jobs`: status documents, optionally of one `status`, at most `limit`."""
+    def jobs(self, status: Union[str, Sequence[str], None] = None,
+             limit: Optional[int] = None) -> List[Dict[str, Any]]:
+        """`GET /jobs`: status documents, newest first, of the given status
+        (one name, a comma-separated string or a list), at most `limit`."""
         query = {}
         if status:
-            query["status"] = status
+            query["status"] = status if isinstance(status, str) else ",".join(status)
         if limit is not None:
             query["limit"] = str(int(limit))
         path = "/jobs" + ("?" + urllib.parse.urlencode(query) if query else "")
