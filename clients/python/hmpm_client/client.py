@@ -337,6 +337,8 @@ class Job:
             if bar:
                 bar.update(doc)
             reconnects = 0 if got_any else reconnects + 1
+            if not self.done:
+                time.sleep(_bounded_sleep(1.0, deadline))  # as the stream's `retry:` asks
 
     def _merge_event(self, data: str) -> None:
         try:
