@@ -145,7 +145,7 @@ class LiveServerCase(unittest.TestCase):
 
 
 def run_cli(args: List[str], env: Optional[Dict[str, str]] = None, cwd: Optional[Path] = None,
-            timeout: float = JOB_TIMEOUT_S + 30) -> subprocess.CompletedProcess:
+            timeout: float = JOB_TIMEOUT_S + 30, input: Optional[str] = None) -> subprocess.CompletedProcess:
     """Runs `python -m hmpm_client ARGS` with this interpreter, bounded."""
     full_env = dict(os.environ)
     full_env.pop("HMPM_TOKEN", None)
@@ -153,7 +153,8 @@ def run_cli(args: List[str], env: Optional[Dict[str, str]] = None, cwd: Optional
     full_env["PYTHONPATH"] = str(CLIENT_DIR) + os.pathsep + full_env.get("PYTHONPATH", "")
     full_env.update(env or {})
     return subprocess.run([sys.executable, "-m", "hmpm_client"] + args, env=full_env,
-                          cwd=str(cwd or REPO), capture_output=True, text=True, timeout=timeout)
+                          cwd=str(cwd or REPO), capture_output=True, text=True, timeout=timeout,
+                          input=input, stdin=None if input is not None else subprocess.DEVNULL)
 
 
 # A vibrating elastic bar (the contract's example, shortened): 13 particles,

@@ -49,6 +49,18 @@ class CliTest(LiveServerCase):
         self.assertIn("100%", r.stderr)
         self.assertIn("successful", r.stderr)
 
+    def test_stdin_results_download(self):
+        r = self.cli("submit", "-", "--wait", "--quiet", input=json.dumps(bar_spec()))
+        self.assertEqual(r.returncode, 0, r.stderr)
+        job_id = r.stdout.strip()
+        r = self.cli("results", job_id)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        self.assertRegex(r.stdout, r"(?m)^\s*\d+\s+[0-9a-f]{64}\s+series\.json$")
+        r = self.cli("download", job_id, str(self.tmp / "dl"))
+        self.assertEqual(r.returncode, 0, r.stderr)
+        self.assertTrue((self.tmp / "dl" / "summary.json").is_file())
+        self.assertIn("sha256 verified", r.stderr)
+
     def test_invalid_spec_exits_non_zero_with_paths(self):
         spec = self.write_spec(invalid_spec())
         r = self.cli("submit", str(spec), "--wait")
