@@ -157,23 +157,6 @@ class ClientTest(LiveServerCase):
         self.assertIn("100%", text)
         self.assertIn("successful", text.splitlines()[-1])
 
-    def test_wait_falls_back_to_polling(self):
-        job = self.client.submit(bar_spec())
-        # Refuse the event stream: the client must notice and poll instead.
-        real_open = self.client.open
-
-        def open_without_events(method, path, *a, **kw):
-            if path.endswith("/events"):
-                raise HmpmError({"type": "about:blank", "title": "stream refused"}, 503)
-            return real_open(method, path, *a, **kw)
-
-        self.client.open = open_without_events
-        try:
-            doc = job.wait(progress=False, timeout=JOB_TIMEOUT_S, poll_interval=0.2)
-        finally:
-            del self.client.open
-        self.assertEqual(doc["status"], "successful")
-
     def test_polling_only(self):
         job = self.client.submit(bar_spec())
         doc = job.wait(progress=False, events=False, timeout=JOB_TIMEOUT_S, poll_interval=0.2)
@@ -212,6 +195,21 @@ class TokenTest(LiveServerCase):
             client = Client(self.server.url)
         self.assertEqual(client.token, self.TOKEN)
         self.assertIsInstance(client.jobs(), list)
+
+
+class NoEventStreamsTest(LiveServerCase):
+    server_args = ["--max-event-streams", "0"]
+
+    def test_wait_falls_back_to_polling(self):
+        client = Client(self.server.url)
+        job = client.submit(bar_spec())
+        with self.assertRaises(HmpmError) as ctx:
+            client.open("GET", job.path + "/events").close()
+        self.assertEqual(ctx.exception.status, 503)
+        out = io.StringIO()
+        doc = job.wait(progress=True, file=out, timeout=JOB_TIMEOUT_S, poll_interval=0.2)
+        self.assertEqual(doc["status"], "successful")
+        self.assertIn("100%", out.getvalue())
 
 
 class QueueFullTest(LiveServerCase):
