@@ -17,6 +17,7 @@
 #include <fstream>
 #include <mutex>
 #include <set>
+#include <sstream>
 #include <thread>
 
 #include "support.hpp"
@@ -341,6 +342,17 @@ TEST_F(ServiceTest, EightClientsSubmitNinetySixJobsWhilePolling) {
   const std::string log = server_->log();
   EXPECT_EQ(log.find("database is locked"), std::string::npos);
   EXPECT_EQ(log.find("\"status\":500"), std::string::npos);
+  // The log is one JSON object per line: a line per request, a line per transition.
+  std::istringstream lines(log);
+  std::size_t requests = 0, transitions = 0;
+  for (std::string line; std::getline(lines, line);) {
+    const Json entry = json_of(line);
+    ASSERT_TRUE(entry.is_object()) << line;
+    requests += entry.value("event", "") == "request";
+    transitions += entry.value("event", "") == "job";
+  }
+  EXPECT_GE(requests, 2u * clients * per_client);       // submits and polls
+  EXPECT_GE(transitions, 3u * clients * per_client);    // accepted, running, successful
 }
 
 TEST_F(ServiceTest, TokenFromTheEnvironmentGuardsAllButHealth) {

@@ -5,6 +5,7 @@
 // stops it in TearDown), then talks to it with httplib::Client — or with raw
 // bytes where a request must be malformed on purpose.
 #include <gtest/gtest.h>
+#include <sqlite3.h>
 
 #include <chrono>
 #include <regex>
@@ -339,6 +340,34 @@ TEST_F(RoutesTest, EventStreamsAreCapped) {
   expect_problem(res, 503, "too-many-streams");
   EXPECT_FALSE(res->get_header_value("Retry-After").empty());
   expect_problem(client_->Get("/jobs/00000000-0000-4000-8000-000000000000/events"), 404, "not-found");
+}
+
+TEST_F(RoutesTest, EventStreamsSendHeartbeatsWhenNothingChanges) {
+  start();
+  const std::string id = submit(long_spec("quiet", 10000));
+  std::string stream;
+  const auto t0 = Clock::now();
+  client_->Get(("/jobs/" + id + "/events").c_str(), [&](const char* data, std::size_t n) {
+    stream.append(data, n);
+    return stream.find(": heartbeat\n") == std::string::npos && Clock::now() - t0 < std::chrono::seconds(10);
+  });
+  EXPECT_NE(stream.find(": heartbeat\n"), std::string::npos) << stream.substr(0, 1000);
+  EXPECT_EQ(client_->Delete(("/jobs/" + id).c_str())->status, 200);
+}
+
+TEST_F(RoutesTest, StoreFailuresAre500WithoutInternalText) {
+  start();
+  sqlite3* db = nullptr;
+  ASSERT_EQ(sqlite3_open((dir_ / "db" / "hmpm.sqlite").c_str(), &db), SQLITE_OK);
+  sqlite3_exec(db, "DROP TABLE results; DROP TABLE jobs;", nullptr, nullptr, nullptr);
+  sqlite3_close(db);
+  auto res = client_->Get("/jobs");
+  expect_problem(res, 500, "internal-error");
+  EXPECT_EQ(res->body.find("no such table"), std::string::npos) << res->body;
+  for (const auto& [name, value] : res->headers) {
+    EXPECT_EQ(value.find("no such table"), std::string::npos) << name << ": " << value;
+  }
+  EXPECT_EQ(client_->Get("/health")->status, 200);  // the file itself is still readable
 }
 
 TEST_F(RoutesTest, ListFiltersAndMetricsCount) {
