@@ -343,8 +343,9 @@ TEST_F(RoutesTest, EventStreamsAreCapped) {
 }
 
 TEST_F(RoutesTest, EventStreamsSendHeartbeatsWhenNothingChanges) {
-  start();
-  const std::string id = submit(long_spec("quiet", 10000));
+  start();  // one worker, kept busy, so the streamed job waits without any change
+  const std::string busy = submit(long_spec("busy", 10000));
+  const std::string id = submit(small_spec("quiet"));
   std::string stream;
   const auto t0 = Clock::now();
   client_->Get(("/jobs/" + id + "/events").c_str(), [&](const char* data, std::size_t n) {
@@ -352,7 +353,8 @@ TEST_F(RoutesTest, EventStreamsSendHeartbeatsWhenNothingChanges) {
     return stream.find(": heartbeat\n") == std::string::npos && Clock::now() - t0 < std::chrono::seconds(10);
   });
   EXPECT_NE(stream.find(": heartbeat\n"), std::string::npos) << stream.substr(0, 1000);
-  EXPECT_EQ(client_->Delete(("/jobs/" + id).c_str())->status, 200);
+  EXPECT_NE(stream.find("\"status\":\"accepted\""), std::string::npos) << stream.substr(0, 1000);
+  EXPECT_EQ(client_->Delete(("/jobs/" + busy).c_str())->status, 200);
 }
 
 TEST_F(RoutesTest, StoreFailuresAre500WithoutInternalText) {
