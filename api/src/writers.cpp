@@ -149,17 +149,19 @@ void write_series_json(const fs::path& path, const Series& s) {
     out << line;
     for (std::size_t f = 0; f < s.fields.size() && f < s.values.size(); ++f) {
       const int nc = field_components(s.fields[f], s.dimension);
+      // Vectors and tensors are arrays of components, also with one component (1D).
+      const bool scalar = field_components(s.fields[f], 3) == 1;
       line = ",\n   ";
       line += json_string(field_name(s.fields[f]));
       line += ": [";
       for (std::size_t r = 0; r < rows; ++r) {
         if (r) line += ", ";
-        if (nc > 1) line += "[";
+        if (!scalar) line += "[";
         for (int c = 0; c < nc; ++c) {
           if (c) line += ", ";
           append_number(line, series_value(s, f, r, p, nc, c), true);
         }
-        if (nc > 1) line += "]";
+        if (!scalar) line += "]";
         if (line.size() > (1u << 16)) {
           out << line;
           line.clear();

@@ -57,9 +57,10 @@ def check_series(d, problems):
             else:
                 names, width = ["_" + s for s in VECTOR_SUFFIX[:dim]], dim
             expected_columns += [f"p{p['index']}_{field}{n}" for n in names]
+            scalar = field in SCALARS
             for r, row in enumerate(values):
-                cells = [row] if width == 1 else row
-                if width > 1 and (not isinstance(row, list) or len(row) != width):
+                cells = [row] if scalar else row
+                if not scalar and (not isinstance(row, list) or len(row) != width):
                     problems.append(f"series.json: {field} row {r} of particle {p['index']} is {row!r}, "
                                     f"expected {width} components")
                     cells = [None] * width

@@ -74,6 +74,22 @@ TEST(Writers, SeriesJsonHasTheContractLayout) {
   EXPECT_FALSE(fs::exists(dir.path() / "series.json.tmp"));
 }
 
+TEST(Writers, OneDimensionalVectorsAreStillArrays) {
+  Series s;
+  s.dimension = 1;
+  s.time = {0.0, 1.0};
+  s.particles = {3};
+  s.initial_positions = {Vec3{0.5, 0, 0}};
+  s.fields = {Field::displacement, Field::pore_pressure};
+  s.values = {{0.25, 0.5}, {7.0, 8.0}};
+  testing::TempDir dir;
+  write_series_json(dir.path() / "series.json", s);
+  const json j = json::parse(testing::read_text(dir.path() / "series.json"));
+  EXPECT_EQ(j["particles"][0]["displacement"], json::parse("[[0.25], [0.5]]"));  // contract: [[ux], ...]
+  EXPECT_EQ(j["particles"][0]["pore_pressure"], json::parse("[7.0, 8.0]"));
+  EXPECT_EQ(j["particles"][0]["initial_position"], json::parse("[0.5]"));
+}
+
 TEST(Writers, SeriesCsvMatchesJson) {
   testing::TempDir dir;
   write_series_csv(dir.path() / "series.csv", synthetic_series());
