@@ -166,7 +166,7 @@ std::optional<std::uint64_t> content_length(const Request& req) {
 // Paths that exist for some method (a wrong method there is 405, not 404).
 bool is_known_resource(const std::string& path) {
   static const std::regex known(std::string("/health|/metrics|/jobs(/") + uuid_pattern +
-                                "(/results(/.+)?|/events)?)?");
+                                "(/results(/.+)?|/events|/spec)?)?");
   return std::regex_match(path, known);
 }
 
@@ -371,6 +371,11 @@ void Service::Impl::install_routes() {
   const std::string job = std::string("/jobs/") + uuid_pattern;
   http.Get(job, guarded([this](const Request& req, Response& res) { get_job(req, res); }));
   http.Delete(job, guarded([this](const Request& req, Response& res) { dismiss_job(req, res); }));
+  http.Get(job + "/spec", guarded([this](const Request& req, Response& res) {
+             const auto found = store.find(req.matches[1]);
+             if (!found) return send_not_found(res, "no job with id " + std::string(req.matches[1]));
+             res.set_content(found->spec, "application/json");  // exactly the bytes submitted
+           }));
   http.Get(job + "/results",
            guarded([this](const Request& req, Response& res) { get_manifest(req, res); }));
   http.Get(job + "/results/(.+)",

@@ -131,6 +131,10 @@ TEST_F(RoutesTest, SubmitPollAndDownloadResults) {
   for (const auto& l : created["links"]) rels.insert(l["rel"].get<std::string>());
   EXPECT_EQ(rels, (std::set<std::string>{"self", "results", "events"}));
 
+  auto stored = client_->Get(("/jobs/" + id + "/spec").c_str());
+  ASSERT_TRUE(stored);
+  EXPECT_EQ(stored->body, small_spec("walk"));  // byte for byte
+
   const Json done = wait_final(id);
   ASSERT_EQ(done.value("status", ""), "successful") << done.dump();
   EXPECT_EQ(done["progress"], 100);
