@@ -80,8 +80,6 @@ std::string quoted_list(const std::vector<std::string>& words) {
   return out;
 }
 
-double saturating_product(double a, double b) { return a * b; }
-
 std::int64_t to_count(double v) {
   if (!(v > 0)) return 0;
   if (v >= 9.2e18) return std::numeric_limits<std::int64_t>::max();
@@ -731,7 +729,7 @@ void JobParser::check_traction_selections() {
     const Box& box = p_.tractions[k].particles;
     const bool any = std::any_of(positions.begin(), positions.end(), [&](const Vec3& x) {
       for (int a = 0; a < dim_; ++a)
-        if (x[a] < box.min[a] || x[a] > box.max[a]) return false;
+        if (x[a] < box.min[a] - 1e-12 || x[a] > box.max[a] + 1e-12) return false;  // as the solver selects
       return true;
     });
     if (!any)
@@ -833,7 +831,7 @@ CostEstimate estimate_cost(const Problem& p) {
   c.dt = stable_step(p).chosen;
   const double steps = c.dt > 0 ? std::ceil(p.time.end / c.dt - 1e-9) : 0.0;
   c.steps = to_count(steps);
-  c.particle_steps = to_count(saturating_product(static_cast<double>(c.particles), steps));
+  c.particle_steps = to_count(static_cast<double>(c.particles) * steps);
   c.memory_bytes = to_count(400.0 * static_cast<double>(c.particles) + 100.0 * nodes);
   const OutputRequest& o = p.output;
   double rows = 0;
