@@ -39,6 +39,12 @@ class ClientTest(LiveServerCase):
             self.assertIn(key, doc)
         job.wait(progress=False, timeout=JOB_TIMEOUT_S)
 
+    def test_spec_comes_back(self):
+        spec = bar_spec()
+        job = self.client.submit(spec)
+        self.assertEqual(job.spec(), spec)
+        job.wait(progress=False, timeout=JOB_TIMEOUT_S)
+
     def test_submit_from_path_and_text(self):
         path = self.tmp / "bar.json"
         path.write_text(json.dumps(bar_spec()))

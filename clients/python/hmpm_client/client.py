@@ -248,6 +248,11 @@ class Job:
     def done(self) -> bool:
         return self.doc.get("status") in TERMINAL_STATUSES
 
+    def spec(self) -> Dict[str, Any]:
+        """`GET /jobs/{id}/spec`: the job spec as it was submitted."""
+        doc = self.client.request("GET", self.path + "/spec")
+        return doc if isinstance(doc, dict) else {}
+
     def cancel(self) -> Dict[str, Any]:
         """`DELETE /jobs/{id}`: cancels the job if it runs and dismisses it."""
         doc = self.client.request("DELETE", self.path)
