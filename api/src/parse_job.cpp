@@ -66,6 +66,10 @@ constexpr Field kFields[] = {Field::position,       Field::displacement,     Fie
                              Field::strain,         Field::porosity,         Field::total_stress};
 constexpr std::string_view kAxisNames[] = {"x", "y", "z"};
 constexpr int kMaxParticlesPerCell = 10;
+// At most this many errors are reported (then one line counting the rest).
+constexpr std::size_t kMaxErrors = 1000;
+// Work bound for laying out bodies (bodies x cells summed over the axes).
+constexpr double kMaxLayoutWork = 5e7;
 // Work bound for checks that visit every particle per selection.
 constexpr double kMaxNearWork = 2e8;
 
@@ -187,6 +191,12 @@ ParseResult JobParser::parse(std::string_view text) {
   parse_root(root);
   if (r_.error_count() == 0) check_whole_problem();
   result.errors = std::move(r_.errors());
+  // A hostile spec can hold millions of mistakes; the first thousand say enough.
+  if (result.errors.size() > kMaxErrors) {
+    const std::size_t more = result.errors.size() - kMaxErrors;
+    result.errors.resize(kMaxErrors);
+    result.errors.push_back({"", std::to_string(more) + " more errors not shown"});
+  }
   if (result.errors.empty()) {
     ParsedJob job;
     job.name = name_;
@@ -666,6 +676,18 @@ std::string JobParser::pointer_for(const std::string& where) const {
 bool JobParser::check_particle_budget() {
   // Count particles from the layout rule without generating them, so a huge
   // body is refused before anything allocates per particle.
+  // Laying out a body walks every cell along each axis; many bodies on a
+  // fine grid would make validation itself slow.
+  double axis_cells = 0;
+  for (int a = 0; a < dim_; ++a) axis_cells += p_.grid.cells[a];
+  const double layout_work = axis_cells * static_cast<double>(p_.bodies.size());
+  if (layout_work > kMaxLayoutWork) {
+    r_.error("/bodies", std::to_string(p_.bodies.size()) + " bodies on a grid of " + format_count(axis_cells) +
+                            " cells summed over the axes is too much work to lay out (" +
+                            format_count(layout_work) + " > " + format_count(kMaxLayoutWork) +
+                            "); merge bodies");
+    return false;
+  }
   double total = 0;
   for (std::size_t b = 0; b < p_.bodies.size(); ++b) {
     const Body& body = p_.bodies[b];

@@ -200,6 +200,28 @@ TEST(MalformedSpecs, EveryErrorIsCollectedNotJustTheFirst) {
   EXPECT_EQ(r.errors.size(), 5u) << listing(r);
 }
 
+TEST(MalformedSpecs, ErrorListIsCappedAtAThousand) {
+  std::string spec = "{";
+  for (int i = 0; i < 5000; ++i) spec += "\"k" + std::to_string(i) + "\": 0, ";
+  spec += "\"dimension\": 1}";
+  const ParseResult r = parse_job(spec);
+  ASSERT_EQ(r.errors.size(), 1001u);
+  EXPECT_EQ(r.errors.back().path, "");
+  EXPECT_NE(r.errors.back().message.find("more errors not shown"), std::string::npos);
+}
+
+TEST(MalformedSpecs, ValidationWorkIsBounded) {
+  // 13 bodies on a 1D grid of 4 million cells: laying them out is refused
+  // before any per-cell loop runs.
+  json spec = json::parse(R"json({"dimension": 1, "grid": {"min": [0], "max": [1], "cells": [4000000]},
+    "materials": {"m": {"model": "linear_elastic", "density": 1, "youngs_modulus": 1, "poisson_ratio": 0}},
+    "bodies": [], "time": {"end": 1}})json");
+  for (int i = 0; i < 13; ++i)
+    spec["bodies"].push_back({{"material", "m"}, {"box", {{"min", {0.0}}, {"max", {1e-6}}}}});
+  const ParseResult r = parse_job(spec.dump());
+  EXPECT_TRUE(has_error(r, "/bodies", "too much work to lay out (52000000 > 50000000)")) << listing(r);
+}
+
 TEST(MalformedSpecs, LimitsAreConfigurable) {
   Limits tight;
   tight.max_particles = 10;
