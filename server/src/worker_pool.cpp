@@ -108,7 +108,11 @@ void WorkerPool::work() {
       registered = !stopping_;
     }
     if (!registered) {  // shutdown began between claim and here
-      store_.requeue(job->id);
+      try {
+        store_.requeue(job->id);
+      } catch (const std::exception& e) {  // recovery at the next start requeues it
+        log_line({{"event", "store_error"}, {"job", job->id}, {"detail", e.what()}});
+      }
       return;
     }
     ++metrics_.busy_workers;
