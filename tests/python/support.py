@@ -45,7 +45,7 @@ class ServerProcess:
         self.token = token
         self.workers = workers
         self.extra = list(extra or [])
-        self.tmp = Path(tempfile.mkdtemp(prefix="hmpm-pytest-"))
+        self.tmp = Path()
         self.proc: Optional[subprocess.Popen] = None
         self.url = ""
         self.stdout_lines: List[str] = []
@@ -58,6 +58,7 @@ class ServerProcess:
                 f"hmpm-server not found at {exe}; build it first "
                 f"(cmake -S . -B build -DCMAKE_BUILD_TYPE=Release && cmake --build build --target hmpm-server) "
                 f"or set HMPM_BUILD_DIR to the build folder")
+        self.tmp = Path(tempfile.mkdtemp(prefix="hmpm-pytest-"))
         cmd = [str(exe), "--host", "127.0.0.1", "--port", "0", "--db", str(self.tmp / "db.sqlite"),
                "--workers", str(self.workers)] + self.extra
         if self.token:
@@ -112,7 +113,8 @@ class ServerProcess:
         if self._log:
             self._log.close()
             self._log = None
-        shutil.rmtree(self.tmp, ignore_errors=True)
+        if self.tmp != Path():
+            shutil.rmtree(self.tmp, ignore_errors=True)
 
     def __enter__(self) -> "ServerProcess":
         return self.start()
