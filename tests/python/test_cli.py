@@ -69,6 +69,20 @@ class CliTest(LiveServerCase):
         self.assertIn("/materials/bar/youngs_modulus", r.stderr)
         self.assertIn("/time", r.stderr)
 
+    def test_failed_job_exits_3_with_reason_and_summary(self):
+        spec = bar_spec()
+        spec["bodies"][0]["initial"]["velocity"] = ["100"]  # the bar flies off the grid
+        out = self.tmp / "out"
+        r = self.cli("submit", str(self.write_spec(spec)), "--wait", "--quiet", "--download", str(out))
+        self.assertEqual(r.returncode, 3, r.stderr)
+        job_id = r.stdout.strip()
+        self.assertIn(f"job {job_id} failed: ", r.stderr)
+        reason = Client(self.server.url).job(job_id).status().get("reason", "")
+        self.assertTrue(reason)
+        self.assertIn(reason, r.stderr)
+        summary = json.loads((out / "summary.json").read_text())
+        self.assertEqual(summary["status"], "failed")
+
     def test_missing_spec_file(self):
         r = self.cli("submit", str(self.tmp / "nope.json"))
         self.assertNotEqual(r.returncode, 0)
