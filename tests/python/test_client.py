@@ -151,6 +151,8 @@ class ClientTest(LiveServerCase):
         first = self.client.submit(bar_spec(), idempotency_key=key)
         second = self.client.submit(bar_spec(), idempotency_key=key)
         self.assertEqual(first.id, second.id)
+        self.assertFalse(first.replayed)
+        self.assertTrue(second.replayed)
         first.wait(progress=False, timeout=JOB_TIMEOUT_S)
 
     def test_progress_bar_follows_events(self):

@@ -149,7 +149,7 @@ class Client:
         `spec` is a path to a JSON file, a dict, JSON text, or bytes. A file
         is sent byte for byte so the service's error paths match it. With an
         `idempotency_key`, repeating the same submission returns the first
-        job instead of creating another. Raises HmpmError when the spec is
+        job (with `.replayed` True) instead of creating another. Raises HmpmError when the spec is
         refused (`.errors` lists every path and message).
         """
         body = _spec_bytes(spec)
@@ -157,6 +157,7 @@ class Client:
         with self.open("POST", "/jobs", body, headers) as resp:
             raw = resp.read()
             location = resp.headers.get("Location", "")
+            replayed = resp.headers.get("Idempotent-Replayed", "").lower() == "true"
         doc: Dict[str, Any] = {}
         if raw.strip():
             try:
@@ -171,6 +172,7 @@ class Client:
                              "detail": raw[:200].decode("utf-8", errors="replace")})
         job = Job(self, str(job_id), doc if isinstance(doc, dict) else {})
         job.end_time = _spec_end_time(body)
+        job.replayed = replayed
         return job
 
     def job(self, job_id: str) -> "Job":
@@ -229,6 +231,7 @@ class Job:
         self.id = job_id
         self.doc: Dict[str, Any] = dict(doc or {})
         self.end_time: Optional[float] = None  # the spec's time.end, when known
+        self.replayed = False  # submit() returned an earlier job for its idempotency key
 
     def __repr__(self) -> str:
         return f"Job({self.id!r}, status={self.doc.get('status')!r})"
