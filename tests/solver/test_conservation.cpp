@@ -1,0 +1,261 @@
+// Conservation laws, the gravity column, the stability of the Darcy inertia
+// term, and how runs end: failures with reasons, cancellation, progress.
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <cmath>
+#include <cstdio>
+#include <numeric>
+
+#include "hmpm/run.hpp"
+#include "problems.hpp"
+
+namespace {
+
+hmpm::Material elastic(double rho, double E, double nu) {
+  hmpm::Material m;
+  m.name = "soil";
+  m.density = rho;
+  m.youngs_modulus = E;
+  m.poisson_ratio = nu;
+  return m;
+}
+
+// A free 2D block spinning and shearing in the middle of a large grid: no
+// boundary, no gravity. Internal forces sum to zero at the nodes (the
+// gradients of a partition of unity sum to zero), so the FLIP update keeps the
+// total momentum to round-off: asserted at 1e-12 of the momentum scale.
+TEST(Conservation, FreeBodyMomentumAndMass) {
+  for (auto shape : {hmpm::ShapeFunction::linear, hmpm::ShapeFunction::gimp, hmpm::ShapeFunction::bspline}) {
+    hmpm::Problem p;
+    p.dimension = 2;
+    p.grid.max = {2.0, 2.0, 0};
+    p.grid.cells = {20, 20, 1};
+    p.shape_function = shape;
+    p.materials.push_back(elastic(1000, 1e6, 0.3));
+    hmpm::Body b;
+    b.box.min = {0.6, 0.6, 0};
+    b.box.max = {1.4, 1.4, 0};
+    b.particles_per_cell = 2;
+    b.initial.velocity[0] = [](const hmpm::Vec3& x) { return 0.5 - 2.0 * (x[1] - 1.0); };
+    b.initial.velocity[1] = [](const hmpm::Vec3& x) { return -0.3 + 2.0 * (x[0] - 1.0) + 1.5 * (x[0] - 1.0) * (x[0] - 1.0); };
+    p.bodies.push_back(b);
+    p.time.end = 0.1;
+    p.output.snapshot_interval = 0.02;
+    p.output.snapshot_fields = {hmpm::Field::velocity};
+    std::vector<std::array<double, 3>> totals;  // px, py, mass
+    hmpm::RunOptions opt;
+    opt.on_snapshot = [&](const hmpm::Snapshot& s) {
+      std::array<double, 3> t{0, 0, 0};
+      for (std::int64_t i = 0; i < s.particles; ++i) {
+        t[0] += s.mass[i] * s.velocity[3 * i];
+        t[1] += s.mass[i] * s.velocity[3 * i + 1];
+        t[2] += s.mass[i];
+      }
+      totals.push_back(t);
+    };
+    const hmpm::RunResult r = hmpm::run(p, opt);
+    ASSERT_EQ(r.status, hmpm::RunStatus::successful) << r.message;
+    ASSERT_GE(totals.size(), 5u);
+    const double scale = totals[0][2] * 1.0;  // mass x 1 m/s
+    for (const auto& t : totals) {
+      EXPECT_NEAR(t[0], totals[0][0], 1e-12 * scale);
+      EXPECT_NEAR(t[1], totals[0][1], 1e-12 * scale);
+      EXPECT_EQ(t[2], totals[0][2]);
+    }
+  }
+}
+
+// Solid mass (1 - n) rho_s V of every particle is conserved exactly by the
+// volume and porosity updates, while the column consolidates (1e-12 relative).
+TEST(Conservation, SolidMassDuringConsolidation) {
+  hmpm::Problem p = problems::column(1, 0, 1.0, 20, 2);
+  hmpm::Material m = elastic(2650, 1e6, 0.0);
+  m.hydraulic = hmpm::Hydraulic{0.4, 1e-4, 50e6, 1000.0, std::numeric_limits<double>::infinity()};
+  p.materials.push_back(m);
+  p.bodies[0].initial.pore_pressure = [](const hmpm::Vec3&) { return 1e4; };
+  p.boundaries.push_back(problems::fixed_velocity(problems::plane(p, 0, 0.0), 0));
+  p.boundaries.push_back(problems::fixed_pressure(problems::plane(p, 0, 1.0), 0.0));
+  hmpm::Traction t;
+  t.particles.min = {0.975, 0, 0};
+  t.particles.max = {1.0, 0, 0};
+  t.traction[0] = problems::constant(-1e4);
+  p.tractions.push_back(t);
+  p.time.end = 0.5;
+  p.output.snapshot_interval = 0.1;
+  p.output.snapshot_fields = {hmpm::Field::porosity, hmpm::Field::strain};
+  std::vector<double> solid;
+  double total_strain = 0;
+  hmpm::RunOptions opt;
+  opt.on_snapshot = [&](const hmpm::Snapshot& s) {
+    double sum = 0;
+    total_strain = 0;
+    for (std::int64_t i = 0; i < s.particles; ++i) {
+      sum += (1 - s.porosity[i]) * s.volume[i];
+      total_strain += s.strain[6 * i];
+    }
+    solid.push_back(sum);
+  };
+  const hmpm::RunResult r = hmpm::run(p, opt);
+  ASSERT_EQ(r.status, hmpm::RunStatus::successful) << r.message;
+  EXPECT_LT(total_strain, -1e-3);  // it did consolidate
+  for (double s : solid) EXPECT_NEAR(s, solid[0], 1e-12 * solid[0]);
+}
+
+// A 2D elastic column under its own weight, bottom fixed, rollers on the
+// sides, reaches sigma_yy = -rho g (H - y0) and sigma_xx = nu/(1-nu) sigma_yy.
+// The waves of the sudden gravity load are removed by local (Cundall)
+// damping, which vanishes at equilibrium and so does not bias the static
+// state (checked: 1.5 s and 3 s give the same stresses). Tolerance 2 % of
+// rho g H at every particle (issue 3): linear elements give a constant
+// stress per cell, so particles a quarter cell from the centre differ from
+// the exact stress by rho g h/4 = 1.25 % of rho g H with 20 cells. E = 10 MPa
+// keeps strains at 0.1 % (with E = 1 MPa, 1.3 % strain, the error grows by
+// about 1 % of rho g H: see docs/verification.md).
+TEST(GravityColumn, ReachesSelfWeightStress) {
+  const double H = 1.0, W = 0.4, rho = 1800, g = 9.81, nu = 0.3;
+  const int ny = 20;
+  for (auto shape : {hmpm::ShapeFunction::linear, hmpm::ShapeFunction::gimp}) {
+    hmpm::Problem p;
+    p.dimension = 2;
+    p.shape_function = shape;
+    p.grid.max = {W, H + 2 * H / ny, 0};
+    p.grid.cells = {8, ny + 2, 1};
+    p.materials.push_back(elastic(rho, 10e6, nu));
+    hmpm::Body b;
+    b.box.max = {W, H, 0};
+    b.particles_per_cell = 2;
+    p.bodies.push_back(b);
+    p.gravity = {0, -g, 0};
+    p.local_damping = 0.15;
+    p.boundaries.push_back(problems::fixed_velocity(problems::plane(p, 0, 0.0), 0));
+    p.boundaries.push_back(problems::fixed_velocity(problems::plane(p, 0, W), 0));
+    hmpm::Boundary bottom = problems::fixed_velocity(problems::plane(p, 1, 0.0), 1);
+    bottom.velocity[0] = problems::constant(0.0);
+    p.boundaries.push_back(bottom);
+    p.time.end = 1.5;  // 30 periods of the column's first mode (4H/c = 0.05 s)
+    p.output.snapshot_interval = p.time.end;
+    p.output.snapshot_fields = {hmpm::Field::effective_stress};
+    double worst_yy = 0, worst_xx = 0;
+    const auto x0 = hmpm::initial_positions(p);
+    hmpm::RunOptions opt;
+    opt.on_snapshot = [&](const hmpm::Snapshot& s) {
+      if (s.index == 0) return;
+      for (std::int64_t i = 0; i < s.particles; ++i) {
+        const double yy = -rho * g * (H - x0[i][1]);
+        worst_yy = std::max(worst_yy, std::abs(s.effective_stress[6 * i + 1] - yy));
+        worst_xx = std::max(worst_xx, std::abs(s.effective_stress[6 * i] - nu / (1 - nu) * yy));
+      }
+    };
+    const hmpm::RunResult r = hmpm::run(p, opt);
+    ASSERT_EQ(r.status, hmpm::RunStatus::successful) << r.message;
+    std::printf("gravity column (%s): worst |syy - exact| = %.3g of rho g H, sxx %.3g\n",
+                shape == hmpm::ShapeFunction::linear ? "linear" : "gimp", worst_yy / (rho * g * H),
+                worst_xx / (rho * g * H));
+    EXPECT_LT(worst_yy, 0.02 * rho * g * H);
+    EXPECT_LT(worst_xx, 0.02 * rho * g * H);
+  }
+}
+
+// The rho_f a term of Darcy's law uses the nodal acceleration of the same
+// step. A saturated bar vibrating freely (closed: no drainage, no load) can
+// only lose energy to Darcy flow; kinetic + elastic + fluid storage energy
+// must never grow by more than the explicit scheme's O(w dt) oscillation
+// (asserted 2 %), from low to very high permeability where the term
+// dominates the flux, and the run must stay finite.
+TEST(DarcyInertia, SameStepAccelerationIsStable) {
+  for (double k : {1e-4, 1e-2, 0.3}) {  // at 0.3 m/s, (k/g) w = 20: the term dominates
+    hmpm::Problem p = problems::column(1, 0, 1.0, 20, 2);
+    hmpm::Material m = elastic(2000, 20e6, 0.0);
+    m.hydraulic = hmpm::Hydraulic{0.3, k, 100e6, 1000.0, std::numeric_limits<double>::infinity()};
+    p.materials.push_back(m);
+    p.bodies[0].initial.velocity[0] = [](const hmpm::Vec3& x) { return 0.05 * std::sin(1.5707963 * x[0]); };
+    p.boundaries.push_back(problems::fixed_velocity(problems::plane(p, 0, 0.0), 0));
+    p.time.end = 0.03;  // 3 periods of the undrained first mode
+    p.output.snapshot_interval = 0.0005;
+    p.output.snapshot_fields = {hmpm::Field::velocity, hmpm::Field::effective_stress, hmpm::Field::strain,
+                                hmpm::Field::pore_pressure};
+    const double Q = 0.3 / 100e6;
+    std::vector<double> energy;
+    hmpm::RunOptions opt;
+    opt.on_snapshot = [&](const hmpm::Snapshot& s) {
+      double e = 0;
+      for (std::int64_t i = 0; i < s.particles; ++i) {
+        e += 0.5 * s.mass[i] * s.velocity[3 * i] * s.velocity[3 * i];
+        e += 0.5 * s.volume[i] * s.effective_stress[6 * i] * s.strain[6 * i];
+        e += 0.5 * Q * s.volume[i] * s.pore_pressure[i] * s.pore_pressure[i];
+      }
+      energy.push_back(e);
+    };
+    const hmpm::RunResult r = hmpm::run(p, opt);
+    ASSERT_EQ(r.status, hmpm::RunStatus::successful) << "k " << k << ": " << r.message;
+    const double peak = *std::max_element(energy.begin(), energy.end());
+    std::printf("darcy inertia k=%g: peak/initial energy %.4f, final/initial %.4f\n", k, peak / energy[0],
+                energy.back() / energy[0]);
+    EXPECT_LT(peak, 1.02 * energy[0]) << "k " << k;
+    EXPECT_LT(energy.back(), energy[0]) << "k " << k;
+  }
+}
+
+hmpm::Problem small_block(double vx, double vgrad) {
+  hmpm::Problem p;
+  p.dimension = 2;
+  p.grid.max = {1, 1, 0};
+  p.grid.cells = {10, 10, 1};
+  p.materials.push_back(elastic(1000, 1e5, 0.2));
+  hmpm::Body b;
+  b.box.min = {0.4, 0.4, 0};
+  b.box.max = {0.6, 0.6, 0};
+  b.initial.velocity[0] = [=](const hmpm::Vec3& x) { return vx - vgrad * (x[0] - 0.5); };
+  p.bodies.push_back(b);
+  p.time.end = 1.0;
+  return p;
+}
+
+TEST(Failure, ParticleLeavingTheGridIsNamed) {
+  const hmpm::RunResult r = hmpm::run(small_block(5.0, 0.0));
+  ASSERT_EQ(r.status, hmpm::RunStatus::failed);
+  EXPECT_NE(r.message.find("left the grid"), std::string::npos) << r.message;
+  EXPECT_NE(r.message.find("particle "), std::string::npos) << r.message;
+  EXPECT_NE(r.message.find("step "), std::string::npos) << r.message;
+  EXPECT_NE(r.message.find("enlarge grid"), std::string::npos) << r.message;
+  // 0.425 m to the edge at 5 m/s: about 0.085 s, not the whole run.
+  EXPECT_LT(r.end_time, 0.1);
+}
+
+TEST(Failure, InvertedVolumeIsNamed) {
+  // Compression rate 1e5 /s: the first step crushes the particles.
+  const hmpm::RunResult r = hmpm::run(small_block(0.0, 1e5));
+  ASSERT_EQ(r.status, hmpm::RunStatus::failed);
+  EXPECT_NE(r.message.find("volume"), std::string::npos) << r.message;
+  EXPECT_NE(r.message.find("What to change"), std::string::npos) << r.message;
+}
+
+TEST(Failure, UserStepAboveTheLimitIsRefusedBeforeRunning) {
+  hmpm::Problem p = small_block(0.0, 0.0);
+  p.time.dt = 1.0;
+  EXPECT_THROW(hmpm::run(p), std::invalid_argument);
+}
+
+TEST(Control, CancellationStopsWithinAStepAndProgressIsReported) {
+  hmpm::Problem p = small_block(0.0, 0.0);
+  p.time.end = 100.0;
+  std::atomic<bool> cancel{false};
+  std::vector<hmpm::Progress> seen;
+  hmpm::RunOptions opt;
+  opt.cancel = &cancel;
+  opt.progress_interval_s = 0.0;  // every step
+  opt.on_progress = [&](const hmpm::Progress& pr) {
+    seen.push_back(pr);
+    if (pr.step == 50) cancel = true;
+  };
+  const hmpm::RunResult r = hmpm::run(p, opt);
+  EXPECT_EQ(r.status, hmpm::RunStatus::cancelled);
+  EXPECT_EQ(r.steps, 50);
+  ASSERT_GE(seen.size(), 50u);
+  EXPECT_GT(seen[10].total_steps, 1000);
+  EXPECT_NEAR(seen[10].fraction, seen[10].time / 100.0, 1e-15);
+  EXPECT_NE(r.message.find("cancelled"), std::string::npos);
+}
+
+}  // namespace
