@@ -1,0 +1,196 @@
+#!/usr/bin/env python3
+"""Runs the verification examples with `hmpm run` and plots them against
+their closed forms: the figures and the error table of docs/verification.md.
+
+    python3 scripts/verification_figures.py [--hmpm build/bin/hmpm] [--out docs/figures]
+
+Prints the error table as Markdown on stdout. Needs numpy and matplotlib
+(Debian: python3-numpy, python3-matplotlib; run it with /usr/bin/python3 or
+`$(bash scripts/python.sh)`).
+"""
+import argparse
+import json
+import math
+import pathlib
+import subprocess
+import tempfile
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+REPO = pathlib.Path(__file__).resolve().parent.parent
+GAMMA_W = 1000.0 * 9.81
+
+
+def run_example(hmpm, name, work):
+    out = pathlib.Path(work) / name
+    subprocess.run([str(hmpm), "run", str(REPO / "examples" / f"{name}.json"), "--out", str(out)],
+                   check=True, capture_output=True)
+    spec = json.loads((REPO / "examples" / f"{name}.json").read_text())
+    series = json.loads((out / "series.json").read_text())
+    return spec, series
+
+
+# ------------------------------------------------------------ closed forms
+def bar_exact(x, t, E, rho, L, v0):
+    beta = math.pi / (2 * L)
+    omega = beta * math.sqrt(E / rho)
+    return v0 / omega * math.sin(omega * t) * math.sin(beta * x), v0 / omega
+
+
+def darcy_exact(x, t, L, dp, c, terms=400):
+    p = dp * (1 - x / L)
+    for m in range(1, terms + 1):
+        e = math.exp(-((m * math.pi / L) ** 2) * c * t)
+        if e < 1e-300:
+            break
+        p -= 2 * dp / (m * math.pi) * math.sin(m * math.pi * x / L) * e
+    return p
+
+
+def terzaghi_exact(z, tv, H, q, terms=400):
+    p = 0.0
+    for m in range(terms):
+        M = math.pi * (2 * m + 1) / 2
+        e = math.exp(-M * M * tv)
+        if e < 1e-300:
+            break
+        p += q * 2 / M * math.sin(M * z / H) * e
+    return p
+
+
+# ------------------------------------------------------------ figures
+def bar_figure(spec, series, out):
+    mat = next(iter(spec["materials"].values()))
+    E, rho = mat["youngs_modulus"], mat["density"]
+    L = spec["bodies"][0]["box"]["max"][0]
+    v0 = 0.1
+    t = series["time"]
+    fig, ax = plt.subplots(figsize=(7, 4))
+    worst, sum2, count = 0.0, 0.0, 0
+    for p in series["particles"]:
+        x = p["initial_position"][0]
+        u = [row[0] for row in p["displacement"]]
+        ue = [bar_exact(x, ti, E, rho, L, v0)[0] for ti in t]
+        amp = bar_exact(x, 0, E, rho, L, v0)[1]
+        sq = sum((a - b) ** 2 for a, b in zip(u, ue))
+        sum2, count = sum2 + sq, count + len(u)
+        worst = max(worst, math.sqrt(sq / len(u)) / amp)
+        line, = ax.plot(t, u, "o", ms=2.5, label=f"particle {p['index'] + 1} (hmpm)")
+        ax.plot(t, ue, "-", color=line.get_color(), lw=1)
+    ax.set_xlabel("time (s)")
+    ax.set_ylabel("displacement (m)")
+    ax.set_title("Vibrating bar: particles 1, 4, 7, 13 (dots) vs exact (lines)")
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(out / "bar-vibration.png", dpi=110)
+    plt.close(fig)
+    pooled = math.sqrt(sum2 / count) / bar_exact(0, 0, E, rho, L, v0)[1]
+    return [("Vibrating bar (paper Fig. 3)", "RMS displacement error / amplitude v0/w, particles 1, 4, 7, 13 together",
+             f"{100 * pooled:.2f} %", "1 %"),
+            ("Vibrating bar (paper Fig. 3)", "worst single particle: RMS error / v0/w (particle 13)",
+             f"{100 * worst:.2f} %", "(see text)")]
+
+
+def darcy_figures(spec, series, out):
+    mat = next(iter(spec["materials"].values()))
+    h = mat["hydraulic"]
+    L = spec["grid"]["max"][0]
+    dp = 100.0
+    c = h["hydraulic_conductivity"] / (GAMMA_W * h["porosity"] / h["fluid_bulk_modulus"])
+    t = series["time"]
+    xs = [p["initial_position"][0] for p in series["particles"]]
+    fig, ax = plt.subplots(figsize=(7, 4))
+    worst = 0.0
+    for target in [0.0002, 0.0005, 0.001, 0.002, 0.005, 0.02]:
+        row = min(range(len(t)), key=lambda i: abs(t[i] - target))
+        pp = [p["pore_pressure"][row] for p in series["particles"]]
+        pe = [darcy_exact(x, t[row], L, dp, c) for x in xs]
+        if c * t[row] / L ** 2 >= 0.02:
+            worst = max(worst, max(abs(a - b) for a, b in zip(pp, pe)) / dp)
+        line, = ax.plot(xs, pp, "o", ms=3, label=f"t = {t[row] * 1000:.1f} ms")
+        fine = [i / 200 * L for i in range(201)]
+        ax.plot(fine, [darcy_exact(x, t[row], L, dp, c) for x in fine], "-", color=line.get_color(), lw=1)
+    ax.set_xlabel("x (m)")
+    ax.set_ylabel("pore pressure (Pa)")
+    ax.set_title("Darcy flow: pressure along the sample (dots) vs series solution (lines)")
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(out / "darcy-pressure.png", dpi=110)
+    plt.close(fig)
+
+    w_exact = h["hydraulic_conductivity"] * dp / (GAMMA_W * L)
+    fig, ax = plt.subplots(figsize=(7, 4))
+    for idx in (0, 9, 19):
+        p = series["particles"][idx]
+        ax.plot([ti * 1000 for ti in t], [w[0] for w in p["darcy_velocity"]], label=f"particle {idx + 1}")
+    ax.axhline(w_exact, color="k", ls="--", lw=1, label="steady k dp/(gamma_w L)")
+    ax.set_xlabel("time (ms)")
+    ax.set_ylabel("Darcy velocity (m/s)")
+    ax.set_title("Darcy flow: Darcy velocity of particles 1, 10, 20")
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(out / "darcy-velocity.png", dpi=110)
+    plt.close(fig)
+    steady_p = max(abs(p["pore_pressure"][-1] - dp * (1 - x / L)) for p, x in zip(series["particles"], xs)) / dp
+    steady_w = max(abs(p["darcy_velocity"][-1][0] - w_exact) for p in series["particles"]) / w_exact
+    return [("Darcy flow (paper Fig. 6)", "max |p - p_exact| / dp, all particles, c t/L^2 >= 0.02",
+             f"{100 * worst:.2f} %", "1 %"),
+            ("Darcy flow, steady (Fig. 6, 7)", "max relative error of p and w at every particle",
+             f"{max(steady_p, steady_w):.1e}", "1e-6")]
+
+
+def terzaghi_figure(spec, series, out, snapshots_dir=None):
+    mat = next(iter(spec["materials"].values()))
+    h = mat["hydraulic"]
+    E, nu = mat["youngs_modulus"], mat["poisson_ratio"]
+    H = spec["grid"]["max"][0]
+    q = 1000.0
+    m_v = (1 + nu) * (1 - 2 * nu) / (E * (1 - nu))
+    Q = h["porosity"] / h["fluid_bulk_modulus"]
+    cv = h["hydraulic_conductivity"] / (GAMMA_W * (m_v + Q))
+    t = series["time"]
+    fig, ax = plt.subplots(figsize=(7, 4))
+    worst = 0.0
+    for p in series["particles"]:
+        z = H - p["initial_position"][0]
+        tv = [ti * cv / H ** 2 for ti in t]
+        pe = [terzaghi_exact(z, v, H, q) for v in tv]
+        for v, a, b in zip(tv, p["pore_pressure"], pe):
+            if v >= 0.05:
+                worst = max(worst, abs(a - b) / q)
+        line, = ax.plot(tv, p["pore_pressure"], "o", ms=2.5, label=f"z = {z:.3f} m")
+        ax.plot(tv, pe, "-", color=line.get_color(), lw=1)
+    ax.set_xlabel("time factor T_v = c_v t / H^2")
+    ax.set_ylabel("excess pore pressure (Pa)")
+    ax.set_title("Terzaghi consolidation: hmpm (dots) vs closed form (lines)")
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(out / "terzaghi.png", dpi=110)
+    plt.close(fig)
+    return [("Terzaghi (verification 3)", "max |p - p_exact| / q, series particles, T_v >= 0.05",
+             f"{100 * worst:.2f} %", "1 %")]
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--hmpm", default=str(REPO / "build" / "bin" / "hmpm"))
+    ap.add_argument("--out", default=str(REPO / "docs" / "figures"))
+    args = ap.parse_args()
+    out = pathlib.Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    rows = []
+    with tempfile.TemporaryDirectory(prefix="hmpm-verification-") as work:
+        rows += bar_figure(*run_example(args.hmpm, "bar-vibration", work), out)
+        rows += darcy_figures(*run_example(args.hmpm, "darcy-flow", work), out)
+        rows += terzaghi_figure(*run_example(args.hmpm, "terzaghi", work), out)
+    print("| problem | measure | hmpm | bound |")
+    print("|---|---|---|---|")
+    for r in rows:
+        print("| " + " | ".join(r) + " |")
+
+
+if __name__ == "__main__":
+    main()
