@@ -13,6 +13,7 @@
 // partition of unity and a zero sum of gradients.
 #pragma once
 
+#include <Eigen/Core>
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -25,7 +26,8 @@ struct Linear {
   static constexpr int K = 2;
   static inline void eval(double xi, int cells, double /*half_length*/, int& base, double* w,
                           double* dw) {
-    int b = static_cast<int>(std::floor(xi));
+    // Particles are inside the grid (xi >= 0), so truncation is floor.
+    int b = static_cast<int>(xi);
     b = std::clamp(b, 0, cells - 1);
     const double f = xi - b;
     base = b;
@@ -61,7 +63,7 @@ struct Gimp {
   }
   static inline void eval(double xi, int cells, double half_length, int& base, double* w,
                           double* dw) {
-    int b = static_cast<int>(std::floor(xi + 0.5)) - 1;
+    int b = static_cast<int>(xi + 0.5) - 1;  // xi >= 0 inside the grid
     b = std::clamp(b, 0, cells - 2);
     base = b;
     for (int k = 0; k < 3; ++k) weight(xi - (b + k), half_length, w[k], dw[k]);
@@ -102,7 +104,7 @@ struct Stencil {
   static constexpr int N = Dim == 1 ? K : (Dim == 2 ? K * K : K * K * K);
   std::array<std::int64_t, N> node;
   std::array<double, N> w;
-  std::array<std::array<double, Dim>, N> grad;
+  std::array<Eigen::Matrix<double, Dim, 1>, N> grad;
 
   /// x: particle position; origin, inv_h: grid; cells, stride: per axis.
   template <class Vec>

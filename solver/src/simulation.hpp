@@ -69,6 +69,7 @@ class Simulation {
       grid_.h[a] = (problem_.grid.max[a] - problem_.grid.min[a]) / grid_.cells[a];
       grid_.inv_h[a] = 1.0 / grid_.h[a];
     }
+    for (int a = 0; a < Dim; ++a) grid_max_[a] = problem_.grid.max[a];
     grid_.count = 1;
     for (int a = 0; a < Dim; ++a) {
       grid_.stride[a] = grid_.count;
@@ -248,14 +249,13 @@ class Simulation {
       const double vol = particles_.volume[p];
       const Vec mv = m * particles_.v[p];
       const Vec mb = m * gravity_;
-      const Mat sig = active_stress(particles_.stress[p]);
+      const Mat vol_sig = vol * active_stress(particles_.stress[p]);
       for (int k = 0; k < StencilT::N; ++k) {
         const std::int64_t i = s.node[k];
         const double w = s.w[k];
-        const Eigen::Map<const Vec> g(s.grad[k].data());
         grid_.mass[i] += w * m;
         grid_.momentum[i] += w * mv;
-        grid_.force[i] += w * mb - vol * (sig * g);
+        grid_.force[i] += w * mb - vol_sig * s.grad[k];
       }
       if (fluid_) {
         const std::uint16_t mat = particles_.material[p];
@@ -293,7 +293,7 @@ class Simulation {
       for (int k = 0; k < StencilT::N; ++k) p_hat += s.w[k] * grid_.pressure[s.node[k]];
       const double vp = particles_.volume[p] * p_hat;
       for (int k = 0; k < StencilT::N; ++k)
-        grid_.force[s.node[k]] += vp * Eigen::Map<const Vec>(s.grad[k].data());
+        grid_.force[s.node[k]] += vp * s.grad[k];
     }
   }
 
@@ -368,7 +368,7 @@ class Simulation {
         if (!mc.saturated) continue;
         Vec grad_p = Vec::Zero();
         for (int k = 0; k < StencilT::N; ++k)
-          grad_p += grid_.pressure[s.node[k]] * Eigen::Map<const Vec>(s.grad[k].data());
+          grad_p += grid_.pressure[s.node[k]] * s.grad[k];
         particles_.darcy[p] =
             -mc.permeability_over_gamma * (grad_p - mc.fluid_density * gravity_ +
                                            darcy_inertia_ * mc.fluid_density * a);
@@ -401,7 +401,7 @@ class Simulation {
       stencil_of(p, s);
       Mat grad_v = Mat::Zero();
       for (int k = 0; k < StencilT::N; ++k)
-        grad_v += grid_.remap[s.node[k]] * Eigen::Map<const Vec>(s.grad[k].data()).transpose();
+        grad_v += grid_.remap[s.node[k]] * s.grad[k].transpose();
       const double vol = particles_.volume[p];
       const std::uint16_t mat = particles_.material[p];
       const MaterialConstants& mc = constants_[mat];
@@ -410,7 +410,7 @@ class Simulation {
         const Vec& w = particles_.darcy[p];
         for (int k = 0; k < StencilT::N; ++k)
           grid_.flux[s.node[k]] +=
-              vol * (Eigen::Map<const Vec>(s.grad[k].data()).dot(w) - s.w[k] * div_v);
+              vol * (s.grad[k].dot(w) - s.w[k] * div_v);
       }
       Voigt de = Voigt::Zero();
       for (int a = 0; a < Dim; ++a) de[a] = grad_v(a, a) * dt;
@@ -464,7 +464,7 @@ class Simulation {
     }
   }
 
-  inline void move_particle(std::size_t p, const StencilT& s, double dt) {
+  __attribute__((always_inline)) inline void move_particle(std::size_t p, const StencilT& s, double dt) {
     Vec dx = Vec::Zero();
     for (int k = 0; k < StencilT::N; ++k) dx += s.w[k] * grid_.velocity[s.node[k]];
     dx *= dt;
@@ -474,10 +474,8 @@ class Simulation {
       fail_nonfinite(p, "velocity");
       return;
     }
-    for (int a = 0; a < Dim; ++a) {
-      const double lo = grid_.origin[a], hi = grid_.origin[a] + grid_.cells[a] * grid_.h[a];
-      if (particles_.x[p][a] < lo || particles_.x[p][a] > hi) fail_left_grid(p);
-    }
+    for (int a = 0; a < Dim; ++a)
+      if (particles_.x[p][a] < grid_.origin[a] || particles_.x[p][a] > grid_max_[a]) fail_left_grid(p);
   }
 
   // ------------------------------------------------------------ failures
@@ -547,6 +545,7 @@ class Simulation {
   std::vector<PressureConstraint> pressure_bcs_;
   std::vector<TractionLoad> tractions_;
   Vec gravity_ = Vec::Zero();
+  Vec grid_max_ = Vec::Zero();
   bool fluid_ = false;
   double darcy_inertia_ = 1.0;  ///< weight of rho_f a in Darcy's law (1: as in the paper)
   double mass_tolerance_ = 0.0;
