@@ -12,7 +12,7 @@ from unittest import mock
 
 from hmpm_client import Client, HmpmError
 
-from .support import JOB_TIMEOUT_S, LiveServerCase, bar_spec, invalid_spec, long_spec, wait_until
+from .support import JOB_TIMEOUT_S, LiveServerCase, bar_spec, column_spec, invalid_spec, long_spec, wait_until
 
 
 class ClientTest(LiveServerCase):
@@ -157,10 +157,11 @@ class ClientTest(LiveServerCase):
 
     def test_progress_bar_follows_events(self):
         out = io.StringIO()
-        job = self.client.submit(bar_spec(end=2.0))
+        job = self.client.submit(column_spec(cells=60, end=0.51))  # about a second
         doc = job.wait(progress=True, timeout=JOB_TIMEOUT_S, file=out)
         self.assertEqual(doc["status"], "successful")
         text = out.getvalue()
+        self.assertRegex(text, r"running .*%  t=[0-9.e-]+/0\.51 s  ETA ")
         self.assertIn(job.id[:8], text)
         self.assertIn("100%", text)
         self.assertIn("successful", text.splitlines()[-1])
