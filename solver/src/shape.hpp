@@ -107,41 +107,57 @@ struct Stencil {
   std::array<Eigen::Matrix<double, Dim, 1>, N> grad;
 
   /// x: particle position; origin, inv_h: grid; cells, stride: per axis.
-  template <class Vec>
+  /// With Grad = false only node indices and weights are filled (passes that
+  /// interpolate values but not gradients).
+  template <bool Grad = true, class Vec>
   inline void compute(const Vec& x, const double* origin, const double* inv_h, const int* cells,
                       const std::int64_t* stride, double half_length) {
     int base[Dim];
     double wa[Dim][K], da[Dim][K];
     for (int a = 0; a < Dim; ++a) {
       Shape::eval((x[a] - origin[a]) * inv_h[a], cells[a], half_length, base[a], wa[a], da[a]);
-      for (int k = 0; k < K; ++k) da[a][k] *= inv_h[a];
+      if constexpr (Grad)
+        for (int k = 0; k < K; ++k) da[a][k] *= inv_h[a];
     }
     if constexpr (Dim == 1) {
       for (int i = 0; i < K; ++i) {
         node[i] = base[0] + i;
         w[i] = wa[0][i];
-        grad[i][0] = da[0][i];
+        if constexpr (Grad) grad[i][0] = da[0][i];
       }
     } else if constexpr (Dim == 2) {
+      const std::int64_t node0 = base[0] + base[1] * stride[1];
       int n = 0;
-      for (int j = 0; j < K; ++j)
+      for (int j = 0; j < K; ++j) {
+        const std::int64_t row = node0 + j * stride[1];
         for (int i = 0; i < K; ++i, ++n) {
-          node[n] = (base[0] + i) + (base[1] + j) * stride[1];
+          node[n] = row + i;
           w[n] = wa[0][i] * wa[1][j];
-          grad[n][0] = da[0][i] * wa[1][j];
-          grad[n][1] = wa[0][i] * da[1][j];
+          if constexpr (Grad) {
+            grad[n][0] = da[0][i] * wa[1][j];
+            grad[n][1] = wa[0][i] * da[1][j];
+          }
         }
+      }
     } else {
+      const std::int64_t node0 = base[0] + base[1] * stride[1] + base[2] * stride[2];
       int n = 0;
       for (int k = 0; k < K; ++k)
-        for (int j = 0; j < K; ++j)
+        for (int j = 0; j < K; ++j) {
+          const std::int64_t row = node0 + j * stride[1] + k * stride[2];
+          const double wjk = wa[1][j] * wa[2][k];
+          const double djk = da[1][j] * wa[2][k];
+          const double wdk = wa[1][j] * da[2][k];
           for (int i = 0; i < K; ++i, ++n) {
-            node[n] = (base[0] + i) + (base[1] + j) * stride[1] + (base[2] + k) * stride[2];
-            w[n] = wa[0][i] * wa[1][j] * wa[2][k];
-            grad[n][0] = da[0][i] * wa[1][j] * wa[2][k];
-            grad[n][1] = wa[0][i] * da[1][j] * wa[2][k];
-            grad[n][2] = wa[0][i] * wa[1][j] * da[2][k];
+            node[n] = row + i;
+            w[n] = wa[0][i] * wjk;
+            if constexpr (Grad) {
+              grad[n][0] = da[0][i] * wjk;
+              grad[n][1] = wa[0][i] * djk;
+              grad[n][2] = wa[0][i] * wdk;
+            }
           }
+        }
     }
   }
 };

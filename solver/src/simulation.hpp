@@ -208,8 +208,9 @@ class Simulation {
     }
   }
 
+  template <bool Grad = true>
   inline void stencil_of(std::size_t p, StencilT& s) const {
-    s.compute(particles_.x[p], grid_.origin, grid_.inv_h, grid_.cells, grid_.stride,
+    s.template compute<Grad>(particles_.x[p], grid_.origin, grid_.inv_h, grid_.cells, grid_.stride,
               particles_.half_length.empty() ? 0.0 : particles_.half_length[p]);
   }
 
@@ -356,7 +357,8 @@ class Simulation {
   void update_particle_velocities_and_remap(double dt) {
     StencilT s;
     for (std::size_t p = 0; p < particles_.size(); ++p) {
-      stencil_of(p, s);
+      if (fluid_) stencil_of<true>(p, s);  // the Darcy velocity needs grad p
+      else stencil_of<false>(p, s);
       Vec a = Vec::Zero();
       for (int k = 0; k < StencilT::N; ++k) a += s.w[k] * grid_.accel[s.node[k]];
       particles_.v[p] += dt * a;
@@ -401,7 +403,7 @@ class Simulation {
       stencil_of(p, s);
       Mat grad_v = Mat::Zero();
       for (int k = 0; k < StencilT::N; ++k)
-        grad_v += grid_.remap[s.node[k]] * s.grad[k].transpose();
+        grad_v.noalias() += grid_.remap[s.node[k]] * s.grad[k].transpose();
       const double vol = particles_.volume[p];
       const std::uint16_t mat = particles_.material[p];
       const MaterialConstants& mc = constants_[mat];
@@ -448,9 +450,9 @@ class Simulation {
   void update_particle_pressure_and_position(double dt) {
     StencilT s;
     for (std::size_t p = 0; p < particles_.size(); ++p) {
-      stencil_of(p, s);
+      stencil_of<false>(p, s);
       if (constants_[particles_.material[p]].saturated) {
-        double dp = 0.0, p_new = 0.0;
+        double dp = 0.0, p_new = 0.0;  // weights only: this pass needs no gradient
         for (int k = 0; k < StencilT::N; ++k) {
           const std::int64_t i = s.node[k];
           dp += s.w[k] * grid_.dp[i];
