@@ -32,7 +32,9 @@ constexpr int kExitRunFailed = 3;
 
 std::atomic<bool> g_cancel{false};
 
-extern "C" void on_interrupt(int) { g_cancel.store(true); }
+extern "C" void on_interrupt(int) {
+  g_cancel.store(true);
+}
 
 const char* const kUsage =
     "usage:\n"
@@ -77,18 +79,22 @@ int load(const std::string& path, hmpm::api::ParseResult& result) {
 }
 
 void print_cost(const hmpm::api::CostEstimate& c) {
-  std::cout << "particles " << c.particles << ", nodes " << c.nodes << ", steps " << c.steps << " (dt " << c.dt
-            << " s), particle-steps " << c.particle_steps << ", memory ~" << c.memory_bytes / 1024 / 1024
-            << " MiB, output ~" << c.output_bytes / 1024 << " KiB, series rows " << c.series_rows
-            << ", snapshots " << c.snapshots << "\n";
+  std::cout << "particles " << c.particles << ", nodes " << c.nodes << ", steps " << c.steps
+            << " (dt " << c.dt << " s), particle-steps " << c.particle_steps << ", memory ~"
+            << c.memory_bytes / 1024 / 1024 << " MiB, output ~" << c.output_bytes / 1024
+            << " KiB, series rows " << c.series_rows << ", snapshots " << c.snapshots << "\n";
 }
 
 std::string format_seconds(double s) {
   char buf[32];
   if (s < 0 || s > 1e7) return "?";
-  if (s < 60) std::snprintf(buf, sizeof buf, "%.0f s", s);
-  else if (s < 3600) std::snprintf(buf, sizeof buf, "%dm%02ds", static_cast<int>(s) / 60, static_cast<int>(s) % 60);
-  else std::snprintf(buf, sizeof buf, "%dh%02dm", static_cast<int>(s) / 3600, static_cast<int>(s) / 60 % 60);
+  if (s < 60)
+    std::snprintf(buf, sizeof buf, "%.0f s", s);
+  else if (s < 3600)
+    std::snprintf(buf, sizeof buf, "%dm%02ds", static_cast<int>(s) / 60, static_cast<int>(s) % 60);
+  else
+    std::snprintf(buf, sizeof buf, "%dh%02dm", static_cast<int>(s) / 3600,
+                  static_cast<int>(s) / 60 % 60);
   return buf;
 }
 
@@ -135,13 +141,15 @@ int command_run(const std::vector<std::string>& args) {
   const auto start = std::chrono::steady_clock::now();
   if (tty) {
     options.on_progress = [start](const hmpm::Progress& p) {
-      const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      const double elapsed =
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
       const double f = std::clamp(p.fraction, 0.0, 1.0);
       const int width = 30, filled = static_cast<int>(f * width);
       const double eta = f > 1e-6 ? elapsed * (1 - f) / f : -1;
-      std::fprintf(stderr, "\r[%s%s] %5.1f%%  t = %.4g / %.4g s  ETA %s   ", std::string(static_cast<std::size_t>(filled), '#').c_str(),
-                   std::string(static_cast<std::size_t>(width - filled), ' ').c_str(), 100 * f, p.time, p.end_time,
-                   format_seconds(eta).c_str());
+      std::fprintf(stderr, "\r[%s%s] %5.1f%%  t = %.4g / %.4g s  ETA %s   ",
+                   std::string(static_cast<std::size_t>(filled), '#').c_str(),
+                   std::string(static_cast<std::size_t>(width - filled), ' ').c_str(), 100 * f,
+                   p.time, p.end_time, format_seconds(eta).c_str());
       std::fflush(stderr);
     };
   }
@@ -160,9 +168,9 @@ int command_run(const std::vector<std::string>& args) {
     std::cerr << "hmpm: run " << hmpm::status_name(r.status) << ": " << r.message << "\n";
     return kExitRunFailed;
   }
-  std::cout << "successful: " << r.steps << " steps of " << r.dt << " s, " << r.particles << " particles, "
-            << r.solve_seconds << " s (" << r.particle_steps_per_second << " particle-steps/s); results in "
-            << out << "\n";
+  std::cout << "successful: " << r.steps << " steps of " << r.dt << " s, " << r.particles
+            << " particles, " << r.solve_seconds << " s (" << r.particle_steps_per_second
+            << " particle-steps/s); results in " << out << "\n";
   return kExitOk;
 }
 
@@ -171,7 +179,8 @@ int command_spec_keys() {
   bool first = true;
   for (const auto& entry : hmpm::api::spec_object_keys()) {
     std::cout << (first ? "\n" : ",\n") << "  \"" << entry.location << "\": [";
-    for (std::size_t i = 0; i < entry.keys.size(); ++i) std::cout << (i ? ", " : "") << '"' << entry.keys[i] << '"';
+    for (std::size_t i = 0; i < entry.keys.size(); ++i)
+      std::cout << (i ? ", " : "") << '"' << entry.keys[i] << '"';
     std::cout << "]";
     first = false;
   }
@@ -187,7 +196,8 @@ int main(int argc, char** argv) {
   const std::string command = args[0];
   args.erase(args.begin());
   if (command == "--help" || command == "-h" || command == "help") {
-    std::cout << "hmpm " << hmpm::api::version() << " — hydro-mechanical MPM for saturated soils\n" << kUsage;
+    std::cout << "hmpm " << hmpm::api::version() << " — hydro-mechanical MPM for saturated soils\n"
+              << kUsage;
     return kExitOk;
   }
   if (command == "--version") {

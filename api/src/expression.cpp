@@ -29,7 +29,8 @@ bool has_assignment(std::string_view s) {
     if (s[i] != '=') continue;
     const char before = i > 0 ? s[i - 1] : ' ';
     const char after = i + 1 < s.size() ? s[i + 1] : ' ';
-    if (before != '<' && before != '>' && before != '!' && before != '=' && after != '=') return true;
+    if (before != '<' && before != '>' && before != '!' && before != '=' && after != '=')
+      return true;
   }
   return false;
 }
@@ -63,14 +64,16 @@ std::shared_ptr<Compiled> compile(std::string_view text, bool time_function, boo
     c->parser.SetExpr(std::string(text));
     c->parser.Eval();  // parses now, so errors surface at validation time
     if (c->parser.GetNumResults() != 1) {
-      error = "formula '" + std::string(text) + "' has " + std::to_string(c->parser.GetNumResults()) +
+      error = "formula '" + std::string(text) + "' has " +
+              std::to_string(c->parser.GetNumResults()) +
               " comma-separated results; exactly one expected";
       return nullptr;
     }
     uses_variables = !c->parser.GetUsedVar().empty();
   } catch (const mu::Parser::exception_type& e) {
-    error = "bad formula '" + std::string(text) + "': " + e.GetMsg() + " (variables: " +
-            (time_function ? "t" : "x, y, z") + "; " + std::string(expression_help) + ")";
+    error = "bad formula '" + std::string(text) + "': " + e.GetMsg() +
+            " (variables: " + (time_function ? "t" : "x, y, z") + "; " +
+            std::string(expression_help) + ")";
     return nullptr;
   }
   return c;
@@ -94,7 +97,8 @@ FieldOfTime constant_field_of_time(double value) {
   return [value](double) { return value; };
 }
 
-std::optional<FieldOfPosition> compile_field_of_position(std::string_view text, std::string& error) {
+std::optional<FieldOfPosition> compile_field_of_position(std::string_view text,
+                                                         std::string& error) {
   bool uses = false;
   auto c = compile(text, false, uses, error);
   if (!c) return std::nullopt;

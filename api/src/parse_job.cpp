@@ -22,20 +22,22 @@ using Keys = std::span<const std::string_view>;
 // ---------------------------------------------------------------- key tables
 // The accepted keys of every object; spec_object_keys() exposes them so the
 // JSON Schema test can compare.
-constexpr std::string_view kTop[] = {"name",     "description",   "dimension",  "grid",
-                                     "shape_function", "materials", "bodies",  "gravity",
-                                     "boundaries", "tractions",   "time",       "output",
-                                     "local_damping", "gravity_constant"};
+constexpr std::string_view kTop[] = {"name",           "description",     "dimension", "grid",
+                                     "shape_function", "materials",       "bodies",    "gravity",
+                                     "boundaries",     "tractions",       "time",      "output",
+                                     "local_damping",  "gravity_constant"};
 constexpr std::string_view kTopRequired[] = {"dimension", "grid", "materials", "bodies", "time"};
 constexpr std::string_view kGrid[] = {"min", "max", "cells"};
-constexpr std::string_view kMaterial[] = {"model",          "density",         "youngs_modulus",
-                                          "poisson_ratio",  "friction_angle",  "dilatancy_angle",
-                                          "cohesion",       "tensile_strength", "hydraulic"};
-constexpr std::string_view kMaterialRequired[] = {"model", "density", "youngs_modulus", "poisson_ratio"};
+constexpr std::string_view kMaterial[] = {"model",         "density",          "youngs_modulus",
+                                          "poisson_ratio", "friction_angle",   "dilatancy_angle",
+                                          "cohesion",      "tensile_strength", "hydraulic"};
+constexpr std::string_view kMaterialRequired[] = {"model", "density", "youngs_modulus",
+                                                  "poisson_ratio"};
 constexpr std::string_view kPlasticKeys[] = {"friction_angle", "dilatancy_angle", "cohesion",
                                              "tensile_strength"};
-constexpr std::string_view kHydraulic[] = {"porosity", "hydraulic_conductivity", "fluid_bulk_modulus",
-                                           "fluid_density", "solid_bulk_modulus"};
+constexpr std::string_view kHydraulic[] = {"porosity", "hydraulic_conductivity",
+                                           "fluid_bulk_modulus", "fluid_density",
+                                           "solid_bulk_modulus"};
 constexpr std::string_view kHydraulicRequired[] = {"porosity", "hydraulic_conductivity",
                                                    "fluid_bulk_modulus"};
 constexpr std::string_view kBody[] = {"material", "box", "particles_per_cell", "initial"};
@@ -58,12 +60,12 @@ constexpr std::string_view kSnapshotsRequired[] = {"interval"};
 constexpr std::string_view kModels[] = {"linear_elastic", "mohr_coulomb", "drucker_prager"};
 constexpr std::string_view kShapes[] = {"linear", "gimp", "bspline"};
 constexpr std::string_view kFaces[] = {"x-", "x+", "y-", "y+", "z-", "z+"};
-constexpr std::string_view kFieldNames[] = {"position",       "displacement",     "velocity",
-                                            "pore_pressure",  "darcy_velocity",   "effective_stress",
-                                            "strain",         "porosity",         "total_stress"};
-constexpr Field kFields[] = {Field::position,       Field::displacement,     Field::velocity,
-                             Field::pore_pressure,  Field::darcy_velocity,   Field::effective_stress,
-                             Field::strain,         Field::porosity,         Field::total_stress};
+constexpr std::string_view kFieldNames[] = {"position",      "displacement",   "velocity",
+                                            "pore_pressure", "darcy_velocity", "effective_stress",
+                                            "strain",        "porosity",       "total_stress"};
+constexpr Field kFields[] = {Field::position,      Field::displacement,   Field::velocity,
+                             Field::pore_pressure, Field::darcy_velocity, Field::effective_stress,
+                             Field::strain,        Field::porosity,       Field::total_stress};
 constexpr std::string_view kAxisNames[] = {"x", "y", "z"};
 constexpr int kMaxParticlesPerCell = 10;
 // At most this many errors are reported (then one line counting the rest).
@@ -96,7 +98,8 @@ std::int64_t cells_inside(const Grid& grid, int axis, double lo, double hi) {
   const double h = (grid.max[axis] - grid.min[axis]) / grid.cells[axis];
   const double tol = 1e-9 * h;
   const double first = std::ceil((lo - tol - grid.min[axis]) / h);
-  const double last = std::floor((hi + tol - grid.min[axis]) / h);  // exclusive upper cell edge index
+  const double last =
+      std::floor((hi + tol - grid.min[axis]) / h);  // exclusive upper cell edge index
   const double a = std::max(first, 0.0);
   const double b = std::min(last, static_cast<double>(grid.cells[axis]));
   return b > a ? static_cast<std::int64_t>(b - a) : 0;
@@ -168,7 +171,7 @@ class JobParser {
   SpecReader r_;
   Problem p_;
   std::string name_ = "job";
-  int dim_ = 0;          // 0 while unknown or invalid: vector lengths are not checked
+  int dim_ = 0;           // 0 while unknown or invalid: vector lengths are not checked
   bool grid_ok_ = false;  // grid valid: boxes can be checked against it
   std::map<std::string, int> material_index_;
   std::vector<PendingNear> near_;
@@ -182,7 +185,8 @@ class JobParser {
 ParseResult JobParser::parse(std::string_view text) {
   ParseResult result;
   if (text.size() > static_cast<std::size_t>(limits_.max_body_bytes)) {
-    result.errors.push_back({"", "spec is " + std::to_string(text.size()) + " bytes; the limit is " +
+    result.errors.push_back({"", "spec is " + std::to_string(text.size()) +
+                                     " bytes; the limit is " +
                                      std::to_string(limits_.max_body_bytes) + " bytes"});
     return result;
   }
@@ -218,7 +222,7 @@ void JobParser::parse_root(const json& root) {
   if (root.contains("grid")) parse_grid(root["grid"], "/grid");
   if (root.contains("shape_function")) {
     if (auto s = r_.one_of(root["shape_function"], "/shape_function", kShapes))
-      p_.shape_function = *s == "gimp" ? ShapeFunction::gimp
+      p_.shape_function = *s == "gimp"      ? ShapeFunction::gimp
                           : *s == "bspline" ? ShapeFunction::bspline
                                             : ShapeFunction::linear;
   }
@@ -241,18 +245,21 @@ void JobParser::parse_root(const json& root) {
   if (root.contains("boundaries")) {
     const json& b = root["boundaries"];
     if (r_.array(b, "/boundaries"))
-      for (std::size_t i = 0; i < b.size(); ++i) parse_boundary(b[i], child_pointer("/boundaries", i));
+      for (std::size_t i = 0; i < b.size(); ++i)
+        parse_boundary(b[i], child_pointer("/boundaries", i));
   }
   if (root.contains("tractions")) {
     const json& t = root["tractions"];
     if (r_.array(t, "/tractions"))
-      for (std::size_t i = 0; i < t.size(); ++i) parse_traction(t[i], child_pointer("/tractions", i));
+      for (std::size_t i = 0; i < t.size(); ++i)
+        parse_traction(t[i], child_pointer("/tractions", i));
   }
   if (root.contains("time")) parse_time(root["time"], "/time");
   if (root.contains("output")) parse_output(root["output"], "/output");
 
   if (any_pore_pressure_bc_ &&
-      std::none_of(p_.materials.begin(), p_.materials.end(), [](const Material& m) { return m.hydraulic.has_value(); }))
+      std::none_of(p_.materials.begin(), p_.materials.end(),
+                   [](const Material& m) { return m.hydraulic.has_value(); }))
     r_.error(first_pore_pressure_bc_, "prescribes pore pressure but no material has 'hydraulic'");
 }
 
@@ -296,7 +303,8 @@ void JobParser::parse_materials(const json& j, const std::string& path) {
     return;
   }
   if (j.empty()) r_.error(path, "is empty; at least one material is needed");
-  for (const auto& [name, value] : j.items()) parse_material(name, value, child_pointer(path, name));
+  for (const auto& [name, value] : j.items())
+    parse_material(name, value, child_pointer(path, name));
 }
 
 void JobParser::parse_material(const std::string& name, const json& j, const std::string& path) {
@@ -311,8 +319,9 @@ void JobParser::parse_material(const std::string& name, const json& j, const std
       const json& v = j["poisson_ratio"];
       const std::string vp = path + "/poisson_ratio";
       if (v.is_number() && v.get<double>() == 0.5)
-        r_.error(vp, "is 0.5; must be in (-1, 0.5): an incompressible skeleton has an infinite "
-                     "wave speed, so no explicit time step is stable");
+        r_.error(vp,
+                 "is 0.5; must be in (-1, 0.5): an incompressible skeleton has an infinite "
+                 "wave speed, so no explicit time step is stable");
       else if (auto nu = r_.number(v, vp, {-1.0, 0.5, true, true}))
         m.poisson_ratio = *nu;
     }
@@ -322,11 +331,13 @@ void JobParser::parse_material(const std::string& name, const json& j, const std
     if (model == "linear_elastic") {
       for (std::string_view key : kPlasticKeys)
         if (j.contains(key))
-          r_.error(child_pointer(path, key),
-                   "applies only to models 'mohr_coulomb' and 'drucker_prager', not 'linear_elastic'");
+          r_.error(
+              child_pointer(path, key),
+              "applies only to models 'mohr_coulomb' and 'drucker_prager', not 'linear_elastic'");
     } else {
       for (std::string_view key : {"friction_angle", "dilatancy_angle", "cohesion"})
-        if (!j.contains(key)) r_.error(child_pointer(path, key), "is required for model '" + model + "'");
+        if (!j.contains(key))
+          r_.error(child_pointer(path, key), "is required for model '" + model + "'");
       double phi = 30, psi = 0, c = 0, t = 0;
       const Range angle{0.0, 90.0, false, true};
       r_.number_at(j, path, "friction_angle", angle, phi);
@@ -343,11 +354,14 @@ void JobParser::parse_material(const std::string& name, const json& j, const std
         if (auto v = r_.number(j["cohesion"], path + "/cohesion", Range::non_negative())) {
           c = *v;
           if (c == 0 && phi == 0 && j.contains("friction_angle"))
-            r_.error(path + "/cohesion", "is 0 with friction_angle 0: the material would have no strength");
+            r_.error(path + "/cohesion",
+                     "is 0 with friction_angle 0: the material would have no strength");
         }
       r_.number_at(j, path, "tensile_strength", Range::non_negative(), t);
-      if (model == "mohr_coulomb") m.plasticity = MohrCoulomb{phi, psi, c, t};
-      else m.plasticity = DruckerPrager{phi, psi, c, t};
+      if (model == "mohr_coulomb")
+        m.plasticity = MohrCoulomb{phi, psi, c, t};
+      else
+        m.plasticity = DruckerPrager{phi, psi, c, t};
     }
     if (j.contains("hydraulic")) parse_hydraulic(m, j["hydraulic"], path + "/hydraulic");
   }
@@ -378,21 +392,24 @@ std::optional<Box> JobParser::parse_box(const json& j, const std::string& path) 
   bool ok = true;
   for (int a = 0; a < dim_; ++a) {
     if ((*hi)[a] < (*lo)[a]) {
-      r_.error(child_pointer(path + "/max", a), "is " + format_number((*hi)[a]) +
-                                                    "; must be >= min " + format_number((*lo)[a]));
+      r_.error(child_pointer(path + "/max", a),
+               "is " + format_number((*hi)[a]) + "; must be >= min " + format_number((*lo)[a]));
       ok = false;
       continue;
     }
     if (!grid_ok_) continue;
     const double tol = 1e-9 * (p_.grid.max[a] - p_.grid.min[a]);
     const std::string range = "; the grid spans [" + format_number(p_.grid.min[a]) + ", " +
-                              format_number(p_.grid.max[a]) + "] along " + std::string(kAxisNames[a]);
+                              format_number(p_.grid.max[a]) + "] along " +
+                              std::string(kAxisNames[a]);
     if ((*lo)[a] < p_.grid.min[a] - tol || (*lo)[a] > p_.grid.max[a] + tol) {
-      r_.error(child_pointer(path + "/min", a), "is " + format_number((*lo)[a]) + ", outside the grid" + range);
+      r_.error(child_pointer(path + "/min", a),
+               "is " + format_number((*lo)[a]) + ", outside the grid" + range);
       ok = false;
     }
     if ((*hi)[a] > p_.grid.max[a] + tol || (*hi)[a] < p_.grid.min[a] - tol) {
-      r_.error(child_pointer(path + "/max", a), "is " + format_number((*hi)[a]) + ", outside the grid" + range);
+      r_.error(child_pointer(path + "/max", a),
+               "is " + format_number((*hi)[a]) + ", outside the grid" + range);
       ok = false;
     }
   }
@@ -407,13 +424,15 @@ std::optional<Box> JobParser::parse_selection(const json& j, const std::string& 
       all = true;
       return Box{p_.grid.min, p_.grid.max};
     }
-    r_.error(path, "expected \"all\" or {\"box\": {\"min\": [...], \"max\": [...]}}, got the string '" +
-                       j.get_ref<const std::string&>().substr(0, 64) + "'");
+    r_.error(path,
+             "expected \"all\" or {\"box\": {\"min\": [...], \"max\": [...]}}, got the string '" +
+                 j.get_ref<const std::string&>().substr(0, 64) + "'");
     return std::nullopt;
   }
   if (!j.is_object()) {
-    r_.error(path, std::string("expected \"all\" or {\"box\": {\"min\": [...], \"max\": [...]}}, got ") +
-                       j.type_name());
+    r_.error(path,
+             std::string("expected \"all\" or {\"box\": {\"min\": [...], \"max\": [...]}}, got ") +
+                 j.type_name());
     return std::nullopt;
   }
   if (!r_.object(j, path, kSelection, kSelection) || !j.contains("box")) return std::nullopt;
@@ -431,7 +450,8 @@ FieldOfPosition JobParser::position_value(const json& j, const std::string& path
     return {};
   }
   if (!j.is_number()) {
-    r_.error(path, std::string("expected a number or a formula string in x, y, z, got ") + j.type_name());
+    r_.error(path,
+             std::string("expected a number or a formula string in x, y, z, got ") + j.type_name());
     return {};
   }
   if (auto v = r_.number(j, path)) return constant_field_of_position(*v);
@@ -467,15 +487,17 @@ void JobParser::parse_body(const json& j, const std::string& path) {
       } else {
         std::vector<std::string> names;
         for (const auto& [n, i] : material_index_) names.push_back(n);
-        r_.error(path + "/material", "unknown material '" + *name + "'; defined materials: " +
-                                         (names.empty() ? std::string("none") : quoted_list(names)));
+        r_.error(path + "/material",
+                 "unknown material '" + *name + "'; defined materials: " +
+                     (names.empty() ? std::string("none") : quoted_list(names)));
       }
     }
   }
   if (j.contains("box"))
     if (auto b = parse_box(j["box"], path + "/box")) body.box = *b;
   if (j.contains("particles_per_cell"))
-    if (auto n = r_.integer(j["particles_per_cell"], path + "/particles_per_cell", 1, kMaxParticlesPerCell))
+    if (auto n = r_.integer(j["particles_per_cell"], path + "/particles_per_cell", 1,
+                            kMaxParticlesPerCell))
       body.particles_per_cell = static_cast<int>(*n);
   if (j.contains("initial")) parse_initial(body, j["initial"], path + "/initial");
   p_.bodies.push_back(std::move(body));
@@ -494,16 +516,19 @@ void JobParser::parse_initial(Body& body, const json& j, const std::string& path
   if (j.contains("pore_pressure")) {
     body.initial.pore_pressure = position_value(j["pore_pressure"], path + "/pore_pressure");
     if (body.material >= 0 && !p_.materials[static_cast<std::size_t>(body.material)].hydraulic)
-      r_.error(path + "/pore_pressure", "is given but material '" +
-                                            p_.materials[static_cast<std::size_t>(body.material)].name +
-                                            "' has no 'hydraulic' properties");
+      r_.error(path + "/pore_pressure",
+               "is given but material '" +
+                   p_.materials[static_cast<std::size_t>(body.material)].name +
+                   "' has no 'hydraulic' properties");
   }
   if (j.contains("effective_stress")) {
     const json& s = j["effective_stress"];
     const std::string sp = path + "/effective_stress";
     if (!s.is_array() || s.size() != 6) {
-      r_.error(sp, "expected an array of 6 numbers or formulas (Voigt order xx, yy, zz, xy, yz, zx), got " +
-                       (s.is_array() ? std::to_string(s.size()) + " entries" : std::string(s.type_name())));
+      r_.error(
+          sp,
+          "expected an array of 6 numbers or formulas (Voigt order xx, yy, zz, xy, yz, zx), got " +
+              (s.is_array() ? std::to_string(s.size()) + " entries" : std::string(s.type_name())));
     } else {
       for (std::size_t k = 0; k < 6; ++k)
         body.initial.effective_stress[k] = position_value(s[k], child_pointer(sp, k));
@@ -522,8 +547,10 @@ void JobParser::parse_boundary(const json& j, const std::string& path) {
       b.nodes.box = *box;
       if (!all && grid_ok_) {
         double count = 1;
-        for (int a = 0; a < dim_; ++a) count *= static_cast<double>(nodes_inside(p_.grid, a, box->min[a], box->max[a]));
-        if (count == 0) r_.error(np + "/box", "selects no grid node; nodes lie at min + i * cell size");
+        for (int a = 0; a < dim_; ++a)
+          count *= static_cast<double>(nodes_inside(p_.grid, a, box->min[a], box->max[a]));
+        if (count == 0)
+          r_.error(np + "/box", "selects no grid node; nodes lie at min + i * cell size");
       }
     }
   }
@@ -563,7 +590,8 @@ void JobParser::parse_traction(const json& j, const std::string& path) {
       t.side = (*f)[1] == '+' ? +1 : -1;
       if (dim_ > 0 && t.axis >= dim_)
         r_.error(path + "/face", "is '" + *f + "', but a " + std::to_string(dim_) +
-                                     "D problem has no " + std::string(kAxisNames[t.axis]) + " axis");
+                                     "D problem has no " + std::string(kAxisNames[t.axis]) +
+                                     " axis");
     }
   }
   if (j.contains("traction")) {
@@ -630,8 +658,11 @@ void JobParser::parse_output(const json& j, const std::string& path) {
                 if (auto n = r_.integer(e, ip, 0, std::numeric_limits<std::int64_t>::max()))
                   out.series_particles.back() = *n;
               } else {
-                r_.error(ip, std::string("expected a particle index (integer >= 0) or {\"near\": [x, ...]}, got ") +
-                                 e.type_name());
+                r_.error(
+                    ip,
+                    std::string(
+                        "expected a particle index (integer >= 0) or {\"near\": [x, ...]}, got ") +
+                        e.type_name());
               }
             }
         }
@@ -682,7 +713,8 @@ bool JobParser::check_particle_budget() {
   for (int a = 0; a < dim_; ++a) axis_cells += p_.grid.cells[a];
   const double layout_work = axis_cells * static_cast<double>(p_.bodies.size());
   if (layout_work > kMaxLayoutWork) {
-    r_.error("/bodies", std::to_string(p_.bodies.size()) + " bodies on a grid of " + format_count(axis_cells) +
+    r_.error("/bodies", std::to_string(p_.bodies.size()) + " bodies on a grid of " +
+                            format_count(axis_cells) +
                             " cells summed over the axes is too much work to lay out (" +
                             format_count(layout_work) + " > " + format_count(kMaxLayoutWork) +
                             "); merge bodies");
@@ -693,13 +725,14 @@ bool JobParser::check_particle_budget() {
     const Body& body = p_.bodies[b];
     double n = 1;
     for (int a = 0; a < dim_; ++a) {
-      const double along = static_cast<double>(cells_inside(p_.grid, a, body.box.min[a], body.box.max[a])) *
-                           body.particles_per_cell;
+      const double along =
+          static_cast<double>(cells_inside(p_.grid, a, body.box.min[a], body.box.max[a])) *
+          body.particles_per_cell;
       if (along > static_cast<double>(limits_.max_particles)) {
         r_.error(child_pointer("/bodies", b) + "/particles_per_cell",
                  "body would have " + format_count(along) + " particles along " +
-                     std::string(kAxisNames[a]) + "; the limit is " + std::to_string(limits_.max_particles) +
-                     " particles in all");
+                     std::string(kAxisNames[a]) + "; the limit is " +
+                     std::to_string(limits_.max_particles) + " particles in all");
         return false;
       }
       n *= along;
@@ -707,8 +740,8 @@ bool JobParser::check_particle_budget() {
     total += n;
   }
   if (total > static_cast<double>(limits_.max_particles)) {
-    r_.error("/bodies", "the bodies would create " + format_count(total) + " particles; the limit is " +
-                            std::to_string(limits_.max_particles));
+    r_.error("/bodies", "the bodies would create " + format_count(total) +
+                            " particles; the limit is " + std::to_string(limits_.max_particles));
     return false;
   }
   return true;
@@ -717,7 +750,8 @@ bool JobParser::check_particle_budget() {
 void JobParser::check_whole_problem() {
   if (!check_particle_budget()) return;
   resolve_near();
-  for (const ProblemIssue& issue : check_problem(p_)) r_.error(pointer_for(issue.where), issue.message);
+  for (const ProblemIssue& issue : check_problem(p_))
+    r_.error(pointer_for(issue.where), issue.message);
   if (r_.error_count() > 0) return;
   check_traction_selections();
   check_formulas_are_finite();
@@ -736,41 +770,47 @@ void JobParser::resolve_near() {
   }
   for (const PendingNear& s : near_) {
     const std::int64_t i = nearest_particle(p_, s.at);
-    if (i < 0) r_.error(s.path, "no particle exists");
-    else p_.output.series_particles[s.slot] = i;
+    if (i < 0)
+      r_.error(s.path, "no particle exists");
+    else
+      p_.output.series_particles[s.slot] = i;
   }
 }
 
 void JobParser::check_traction_selections() {
   // A convenience check, skipped when it would cost more than a moment.
   if (p_.tractions.empty() ||
-      static_cast<double>(p_.tractions.size()) * static_cast<double>(count_particles(p_)) > kMaxNearWork)
+      static_cast<double>(p_.tractions.size()) * static_cast<double>(count_particles(p_)) >
+          kMaxNearWork)
     return;
   const std::vector<Vec3> positions = initial_positions(p_);
   for (std::size_t k = 0; k < p_.tractions.size(); ++k) {
     const Box& box = p_.tractions[k].particles;
     const bool any = std::any_of(positions.begin(), positions.end(), [&](const Vec3& x) {
       for (int a = 0; a < dim_; ++a)
-        if (x[a] < box.min[a] - 1e-12 || x[a] > box.max[a] + 1e-12) return false;  // as the solver selects
+        if (x[a] < box.min[a] - 1e-12 || x[a] > box.max[a] + 1e-12)
+          return false;  // as the solver selects
       return true;
     });
     if (!any)
-      r_.error(traction_paths_[k], "selects no particle; particles sit at sub-cell centres, e.g. the "
-                                   "top row of a body is half a particle spacing below its top face");
+      r_.error(traction_paths_[k],
+               "selects no particle; particles sit at sub-cell centres, e.g. the "
+               "top row of a body is half a particle spacing below its top face");
   }
 }
 
 void JobParser::check_formulas_are_finite() {
   // Time functions: at up to 1001 instants over [0, end], about a million
   // evaluations in all.
-  const int intervals = static_cast<int>(
-      std::clamp(1e6 / static_cast<double>(std::max<std::size_t>(time_formulas_.size(), 1)), 1.0, 1000.0));
+  const int intervals = static_cast<int>(std::clamp(
+      1e6 / static_cast<double>(std::max<std::size_t>(time_formulas_.size(), 1)), 1.0, 1000.0));
   for (const TimeFormula& tf : time_formulas_) {
     for (int k = 0; k <= intervals; ++k) {
       const double t = p_.time.end * k / intervals;
       const double v = tf.f(t);
       if (!std::isfinite(v)) {
-        r_.error(tf.path, "the formula gives " + format_number(v) + " at t = " + format_number(t) + " s");
+        r_.error(tf.path,
+                 "the formula gives " + format_number(v) + " at t = " + format_number(t) + " s");
         break;
       }
     }
@@ -817,21 +857,22 @@ void JobParser::check_limits() {
   const StableStep s = stable_step(p_);
   const double steps = std::ceil(p_.time.end / s.chosen - 1e-9);
   if (steps > static_cast<double>(limits_.max_steps)) {
-    const std::string why = p_.time.dt ? "end " + format_number(p_.time.end) + " s / dt " + format_number(s.chosen) + " s"
-                                       : "end " + format_number(p_.time.end) + " s / automatic dt " +
-                                             format_number(s.chosen) + " s";
-    r_.error(p_.time.dt ? "/time/dt" : "/time/end", "the run needs " + format_count(steps) + " time steps (" +
-                                                        why + "); the limit is " +
+    const std::string why = p_.time.dt ? "end " + format_number(p_.time.end) + " s / dt " +
+                                             format_number(s.chosen) + " s"
+                                       : "end " + format_number(p_.time.end) +
+                                             " s / automatic dt " + format_number(s.chosen) + " s";
+    r_.error(p_.time.dt ? "/time/dt" : "/time/end", "the run needs " + format_count(steps) +
+                                                        " time steps (" + why + "); the limit is " +
                                                         std::to_string(limits_.max_steps));
   }
   if (c.series_rows > limits_.max_series_rows)
-    r_.error("/output/series/interval", "the series would have " + std::to_string(c.series_rows) +
-                                            " rows; the limit is " + std::to_string(limits_.max_series_rows) +
-                                            "; use a larger interval");
+    r_.error("/output/series/interval",
+             "the series would have " + std::to_string(c.series_rows) + " rows; the limit is " +
+                 std::to_string(limits_.max_series_rows) + "; use a larger interval");
   if (c.snapshots > limits_.max_snapshots)
-    r_.error("/output/snapshots/interval", "the run would write " + std::to_string(c.snapshots) +
-                                               " snapshots; the limit is " + std::to_string(limits_.max_snapshots) +
-                                               "; use a larger interval");
+    r_.error("/output/snapshots/interval",
+             "the run would write " + std::to_string(c.snapshots) + " snapshots; the limit is " +
+                 std::to_string(limits_.max_snapshots) + "; use a larger interval");
   if (c.output_bytes > limits_.max_output_bytes)
     r_.error("/output", "the result files would take about " + std::to_string(c.output_bytes) +
                             " bytes; the limit is " + std::to_string(limits_.max_output_bytes));
@@ -858,9 +899,11 @@ CostEstimate estimate_cost(const Problem& p) {
   const OutputRequest& o = p.output;
   double rows = 0;
   if (!o.series_particles.empty() && !o.series_fields.empty())
-    rows = o.series_interval <= c.dt ? steps + 1 : std::floor(p.time.end / o.series_interval + 1e-9) + 1;
+    rows = o.series_interval <= c.dt ? steps + 1
+                                     : std::floor(p.time.end / o.series_interval + 1e-9) + 1;
   c.series_rows = to_count(rows);
-  const double snaps = o.snapshot_interval > 0 ? std::floor(p.time.end / o.snapshot_interval + 1e-9) + 1 : 0;
+  const double snaps =
+      o.snapshot_interval > 0 ? std::floor(p.time.end / o.snapshot_interval + 1e-9) + 1 : 0;
   c.snapshots = to_count(snaps);
   double series_values = 0;
   for (Field f : o.series_fields) series_values += field_components(f, dim);
@@ -876,8 +919,9 @@ CostEstimate estimate_cost(const Problem& p) {
   }
   // ~22 characters per number in series.json and again in series.csv;
   // base64 float64 in the VTU files is 8 * 4/3 bytes per number.
-  const double bytes = 4096 + rows * (1 + series_values) * 2 * 22 +
-                       snaps * (static_cast<double>(c.particles) * (snapshot_values * 32.0 / 3.0 + 16) + 4096);
+  const double bytes =
+      4096 + rows * (1 + series_values) * 2 * 22 +
+      snaps * (static_cast<double>(c.particles) * (snapshot_values * 32.0 / 3.0 + 16) + 4096);
   c.output_bytes = to_count(bytes);
   return c;
 }
@@ -885,7 +929,8 @@ CostEstimate estimate_cost(const Problem& p) {
 const std::vector<SpecObjectKeys>& spec_object_keys() {
   static const std::vector<SpecObjectKeys> table = [] {
     auto entry = [](std::string location, Keys keys) {
-      return SpecObjectKeys{std::move(location), std::vector<std::string>(keys.begin(), keys.end())};
+      return SpecObjectKeys{std::move(location),
+                            std::vector<std::string>(keys.begin(), keys.end())};
     };
     return std::vector<SpecObjectKeys>{
         entry("", kTop),
@@ -911,7 +956,9 @@ const std::vector<SpecObjectKeys>& spec_object_keys() {
   return table;
 }
 
-const char* version() { return HMPM_VERSION; }
+const char* version() {
+  return HMPM_VERSION;
+}
 
 ParseResult parse_job(std::string_view json_text, const Limits& limits) {
   try {

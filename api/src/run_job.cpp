@@ -18,7 +18,8 @@ JobOutcome run_job(const ParsedJob& job, const fs::path& out_dir, const hmpm::Ru
   std::error_code ec;
   fs::create_directories(out_dir, ec);
   if (ec || !fs::is_directory(out_dir))
-    throw std::runtime_error("cannot create output directory " + out_dir.string() + ": " + ec.message());
+    throw std::runtime_error("cannot create output directory " + out_dir.string() + ": " +
+                             ec.message());
 
   JobOutcome outcome;
   std::vector<std::pair<double, std::string>> snapshots;
@@ -41,8 +42,9 @@ JobOutcome run_job(const ParsedJob& job, const fs::path& out_dir, const hmpm::Ru
     outcome.run = hmpm::run(job.problem, opts);
   } catch (const std::exception& e) {
     outcome.run.status = RunStatus::failed;
-    outcome.run.message = write_error.empty() ? std::string("the solver refused the problem: ") + e.what()
-                                              : "could not write results: " + write_error;
+    outcome.run.message = write_error.empty()
+                              ? std::string("the solver refused the problem: ") + e.what()
+                              : "could not write results: " + write_error;
   }
 
   for (const auto& [time, name] : snapshots) outcome.files.push_back(name);
@@ -69,7 +71,9 @@ JobOutcome run_job(const ParsedJob& job, const fs::path& out_dir, const hmpm::Ru
 }
 
 std::string media_type_for(std::string_view name) {
-  auto ends = [&](std::string_view s) { return name.size() >= s.size() && name.substr(name.size() - s.size()) == s; };
+  auto ends = [&](std::string_view s) {
+    return name.size() >= s.size() && name.substr(name.size() - s.size()) == s;
+  };
   if (ends(".json")) return "application/json";
   if (ends(".csv")) return "text/csv";
   if (ends(".pvd") || ends(".vtu")) return "application/xml";

@@ -11,9 +11,12 @@ std::string escape_pointer_token(std::string_view token) {
   std::string out;
   out.reserve(token.size());
   for (char c : token) {
-    if (c == '~') out += "~0";
-    else if (c == '/') out += "~1";
-    else out += c;
+    if (c == '~')
+      out += "~0";
+    else if (c == '/')
+      out += "~1";
+    else
+      out += c;
   }
   return out;
 }
@@ -50,8 +53,9 @@ class DomBuilder {
   bool end_array() { return close(); }
   bool key(json::string_t& k) {
     if (stack_.back()->contains(k)) {
-      errors_.push_back({child_pointer(paths_.back(), k), "duplicate key '" + k.substr(0, 64) +
-                                                            "'; each key may appear once in an object"});
+      errors_.push_back(
+          {child_pointer(paths_.back(), k),
+           "duplicate key '" + k.substr(0, 64) + "'; each key may appear once in an object"});
       failed_ = true;
     }
     key_ = std::move(k);
@@ -60,11 +64,14 @@ class DomBuilder {
   bool parse_error(std::size_t, const std::string&, const nlohmann::detail::exception& e) {
     std::string what = e.what();
     // Drop nlohmann's "[json.exception.parse_error.101] " prefix.
-    if (const auto pos = what.find("] "); what.rfind("[json.exception.", 0) == 0 && pos != std::string::npos)
+    if (const auto pos = what.find("] ");
+        what.rfind("[json.exception.", 0) == 0 && pos != std::string::npos)
       what = what.substr(pos + 2);
     // A number too large for a double is well-formed JSON: say where it is.
-    if (e.id == 406) errors_.push_back({next_pointer(), "is not a finite number: " + what});
-    else errors_.push_back({"", "not valid JSON: " + what});
+    if (e.id == 406)
+      errors_.push_back({next_pointer(), "is not a finite number: " + what});
+    else
+      errors_.push_back({"", "not valid JSON: " + what});
     failed_ = true;
     return false;
   }
@@ -128,17 +135,21 @@ bool parse_json_guarded(std::string_view text, int max_depth, json& out,
     const char c = text[i];
     if (c == '\n') ++line;
     if (in_string) {
-      if (escaped) escaped = false;
-      else if (c == '\\') escaped = true;
-      else if (c == '"') in_string = false;
+      if (escaped)
+        escaped = false;
+      else if (c == '\\')
+        escaped = true;
+      else if (c == '"')
+        in_string = false;
       continue;
     }
-    if (c == '"') in_string = true;
+    if (c == '"')
+      in_string = true;
     else if (c == '[' || c == '{') {
       if (++depth > max_depth) {
-        errors.push_back({"", "not accepted: brackets nested deeper than " + std::to_string(max_depth) +
-                                  " levels (byte " + std::to_string(i + 1) + ", line " +
-                                  std::to_string(line) + ")"});
+        errors.push_back({"", "not accepted: brackets nested deeper than " +
+                                  std::to_string(max_depth) + " levels (byte " +
+                                  std::to_string(i + 1) + ", line " + std::to_string(line) + ")"});
         return false;
       }
     } else if (c == ']' || c == '}') {
@@ -166,8 +177,8 @@ bool Range::contains(double v) const {
 std::string Range::describe() const {
   const bool has_lo = std::isfinite(lo), has_hi = std::isfinite(hi);
   if (has_lo && has_hi)
-    return std::string("in ") + (lo_open ? "(" : "[") + format_number(lo) + ", " + format_number(hi) +
-           (hi_open ? ")" : "]");
+    return std::string("in ") + (lo_open ? "(" : "[") + format_number(lo) + ", " +
+           format_number(hi) + (hi_open ? ")" : "]");
   if (has_lo) return std::string(lo_open ? "> " : ">= ") + format_number(lo);
   if (has_hi) return std::string(hi_open ? "< " : "<= ") + format_number(hi);
   return "finite";
@@ -236,7 +247,8 @@ void SpecReader::error(std::string path, std::string message) {
   errors_.push_back({std::move(path), std::move(message)});
 }
 
-bool SpecReader::object(const json& j, const std::string& path, std::span<const std::string_view> known,
+bool SpecReader::object(const json& j, const std::string& path,
+                        std::span<const std::string_view> known,
                         std::span<const std::string_view> required) {
   if (!j.is_object()) {
     error(path, std::string("expected an object, got ") + j.type_name());
@@ -246,9 +258,9 @@ bool SpecReader::object(const json& j, const std::string& path, std::span<const 
     if (std::find(known.begin(), known.end(), key) != known.end()) continue;
     const std::string near = nearest_word(key, known);
     const std::string shown = key.size() > 64 ? key.substr(0, 64) + "..." : key;
-    error(child_pointer(path, key), "unknown key '" + shown + "'; " +
-                                        (near.empty() ? "expected one of " + join(known)
-                                                      : "did you mean '" + near + "'?"));
+    error(child_pointer(path, key),
+          "unknown key '" + shown + "'; " +
+              (near.empty() ? "expected one of " + join(known) : "did you mean '" + near + "'?"));
   }
   for (std::string_view key : required)
     if (!j.contains(key)) error(child_pointer(path, key), "is required");
@@ -267,7 +279,8 @@ bool SpecReader::array(const json& j, const std::string& path, std::size_t min_s
   return true;
 }
 
-std::optional<double> SpecReader::number(const json& j, const std::string& path, const Range& range) {
+std::optional<double> SpecReader::number(const json& j, const std::string& path,
+                                         const Range& range) {
   if (!j.is_number()) {
     error(path, "expected a number " + range.describe() + ", got " + j.type_name());
     return std::nullopt;
@@ -284,8 +297,8 @@ std::optional<double> SpecReader::number(const json& j, const std::string& path,
   return v;
 }
 
-std::optional<std::int64_t> SpecReader::integer(const json& j, const std::string& path, std::int64_t lo,
-                                                std::int64_t hi) {
+std::optional<std::int64_t> SpecReader::integer(const json& j, const std::string& path,
+                                                std::int64_t lo, std::int64_t hi) {
   const std::string want = "an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]";
   if (!j.is_number()) {
     error(path, "expected " + want + ", got " + j.type_name());
@@ -343,7 +356,8 @@ std::optional<std::string> SpecReader::one_of(const json& j, const std::string& 
 
 bool SpecReader::per_axis(const json& j, const std::string& path, int dim, std::string_view entry) {
   if (!j.is_array()) {
-    error(path, "expected an array with one " + std::string(entry) + " per axis, got " + j.type_name());
+    error(path,
+          "expected an array with one " + std::string(entry) + " per axis, got " + j.type_name());
     return false;
   }
   if (dim > 0 && j.size() != static_cast<std::size_t>(dim)) {
@@ -360,8 +374,10 @@ std::optional<Vec3> SpecReader::vector(const json& j, const std::string& path, i
   bool ok = true;
   for (std::size_t i = 0; i < j.size() && i < 3; ++i) {
     const auto c = number(j[i], child_pointer(path, i));
-    if (c) v[i] = *c;
-    else ok = false;
+    if (c)
+      v[i] = *c;
+    else
+      ok = false;
   }
   if (!ok || dim <= 0) return std::nullopt;
   return v;

@@ -41,7 +41,9 @@ struct Range {
   bool lo_open = false;
   bool hi_open = false;
   static Range positive() { return {0.0, std::numeric_limits<double>::infinity(), true, false}; }
-  static Range non_negative() { return {0.0, std::numeric_limits<double>::infinity(), false, false}; }
+  static Range non_negative() {
+    return {0.0, std::numeric_limits<double>::infinity(), false, false};
+  }
   static Range any() { return {}; }
   bool contains(double v) const;
   std::string describe() const;  ///< "> 0", "in (0, 1)", ...
@@ -74,7 +76,8 @@ class SpecReader {
   /// When object `j` has `key`, reads it as a number in `range` into
   /// `target` (left unchanged on error). Returns whether the value was valid.
   template <typename T>
-  bool number_at(const json& j, const std::string& path, std::string_view key, const Range& range, T& target) {
+  bool number_at(const json& j, const std::string& path, std::string_view key, const Range& range,
+                 T& target) {
     if (!j.contains(key)) return false;
     const auto v = number(j[std::string(key)], child_pointer(path, key), range);
     if (v) target = *v;
@@ -84,7 +87,7 @@ class SpecReader {
   std::optional<std::int64_t> integer(const json& j, const std::string& path, std::int64_t lo,
                                       std::int64_t hi);
   std::optional<std::string> string(const json& j, const std::string& path,
-                                     std::size_t max_length = 256);
+                                    std::size_t max_length = 256);
   /// A string that is one of `allowed`; the message lists them.
   std::optional<std::string> one_of(const json& j, const std::string& path,
                                     std::span<const std::string_view> allowed);

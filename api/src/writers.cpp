@@ -30,7 +30,9 @@ void AtomicFile::commit() {
   out_.close();
   std::error_code ec;
   fs::rename(tmp_, path_, ec);
-  if (ec) throw std::runtime_error("cannot rename " + tmp_.string() + " to " + path_.string() + ": " + ec.message());
+  if (ec)
+    throw std::runtime_error("cannot rename " + tmp_.string() + " to " + path_.string() + ": " +
+                             ec.message());
   committed_ = true;
 }
 
@@ -50,11 +52,21 @@ std::string json_string(const std::string& s) {
   std::string out = "\"";
   for (unsigned char c : s) {
     switch (c) {
-      case '"': out += "\\\""; break;
-      case '\\': out += "\\\\"; break;
-      case '\n': out += "\\n"; break;
-      case '\r': out += "\\r"; break;
-      case '\t': out += "\\t"; break;
+      case '"':
+        out += "\\\"";
+        break;
+      case '\\':
+        out += "\\\\";
+        break;
+      case '\n':
+        out += "\\n";
+        break;
+      case '\r':
+        out += "\\r";
+        break;
+      case '\t':
+        out += "\\t";
+        break;
       default:
         if (c < 0x20) {
           char buf[8];
@@ -78,7 +90,9 @@ double series_value(const Series& s, std::size_t f, std::size_t r, std::size_t p
   return i < s.values[f].size() ? s.values[f][i] : std::nan("");
 }
 
-std::size_t series_rows(const Series& s) { return s.time.size(); }
+std::size_t series_rows(const Series& s) {
+  return s.time.size();
+}
 
 }  // namespace
 
@@ -105,14 +119,17 @@ void write_summary(const fs::path& path, const std::string& job_name, const RunR
   field("solve_seconds", num(run.solve_seconds));
   field("particle_steps_per_second", num(run.particle_steps_per_second));
   std::string warnings = "[";
-  for (std::size_t i = 0; i < run.warnings.size(); ++i) warnings += (i ? ", " : "") + json_string(run.warnings[i]);
+  for (std::size_t i = 0; i < run.warnings.size(); ++i)
+    warnings += (i ? ", " : "") + json_string(run.warnings[i]);
   field("warnings", warnings + "]");
   field("name", json_string(job_name));
   field("hmpm_version", json_string(version()));
   field("state_bytes", std::to_string(run.state_bytes));
-  std::string c = "{\"particles\": " + std::to_string(cost.particles) + ", \"nodes\": " + std::to_string(cost.nodes) +
-                  ", \"cells\": " + std::to_string(cost.cells) + ", \"steps\": " + std::to_string(cost.steps) +
-                  ", \"dt\": " + num(cost.dt) + ", \"particle_steps\": " + std::to_string(cost.particle_steps) +
+  std::string c = "{\"particles\": " + std::to_string(cost.particles) +
+                  ", \"nodes\": " + std::to_string(cost.nodes) +
+                  ", \"cells\": " + std::to_string(cost.cells) +
+                  ", \"steps\": " + std::to_string(cost.steps) + ", \"dt\": " + num(cost.dt) +
+                  ", \"particle_steps\": " + std::to_string(cost.particle_steps) +
                   ", \"memory_bytes\": " + std::to_string(cost.memory_bytes) +
                   ", \"output_bytes\": " + std::to_string(cost.output_bytes) +
                   ", \"series_rows\": " + std::to_string(cost.series_rows) +
@@ -143,7 +160,11 @@ void write_series_json(const fs::path& path, const Series& s) {
     line += "\"index\": " + std::to_string(s.particles[p]) + ", \"initial_position\": [";
     for (int a = 0; a < s.dimension; ++a) {
       if (a) line += ", ";
-      append_number(line, p < s.initial_positions.size() ? s.initial_positions[p][static_cast<std::size_t>(a)] : std::nan(""), true);
+      append_number(line,
+                    p < s.initial_positions.size()
+                        ? s.initial_positions[p][static_cast<std::size_t>(a)]
+                        : std::nan(""),
+                    true);
     }
     line += "]";
     out << line;
@@ -186,8 +207,10 @@ void write_series_csv(const fs::path& path, const Series& s) {
       for (int c = 0; c < nc; ++c) {
         line += ",p" + std::to_string(s.particles[p]) + "_" + field_name(s.fields[f]);
         // Vectors always carry an axis suffix (also in 1D), scalars none.
-        if (nc == 6) line += std::string("_") + kTensorSuffix[c];
-        else if (field_components(s.fields[f], 3) == 3) line += std::string("_") + kVectorSuffix[c];
+        if (nc == 6)
+          line += std::string("_") + kTensorSuffix[c];
+        else if (field_components(s.fields[f], 3) == 3)
+          line += std::string("_") + kVectorSuffix[c];
       }
     }
   }
@@ -259,14 +282,15 @@ class Base64Writer {
 // One inline binary DataArray: UInt64 byte count then the values, encoded
 // together (uncompressed layout of the VTK XML format).
 template <typename T, typename Source>
-void data_array(std::ostream& out, const char* type, const std::string& name, int components, std::size_t count,
-                Source value) {
+void data_array(std::ostream& out, const char* type, const std::string& name, int components,
+                std::size_t count, Source value) {
   out << "        <DataArray type=\"" << type << "\"";
   if (!name.empty()) out << " Name=\"" << name << "\"";
   if (components > 1) out << " NumberOfComponents=\"" << components << "\"";
   out << " format=\"binary\">\n";
   Base64Writer b64(out);
-  const std::uint64_t bytes = static_cast<std::uint64_t>(count) * static_cast<std::uint64_t>(components) * sizeof(T);
+  const std::uint64_t bytes =
+      static_cast<std::uint64_t>(count) * static_cast<std::uint64_t>(components) * sizeof(T);
   b64.write(&bytes, sizeof bytes);
   for (std::size_t i = 0; i < count * static_cast<std::size_t>(components); ++i) {
     const T v = value(i);
@@ -278,15 +302,24 @@ void data_array(std::ostream& out, const char* type, const std::string& name, in
 
 const std::vector<double>* snapshot_array(const Snapshot& s, Field f) {
   switch (f) {
-    case Field::position: return &s.position;
-    case Field::displacement: return &s.displacement;
-    case Field::velocity: return &s.velocity;
-    case Field::pore_pressure: return &s.pore_pressure;
-    case Field::darcy_velocity: return &s.darcy_velocity;
-    case Field::effective_stress: return &s.effective_stress;
-    case Field::total_stress: return &s.total_stress;
-    case Field::strain: return &s.strain;
-    case Field::porosity: return &s.porosity;
+    case Field::position:
+      return &s.position;
+    case Field::displacement:
+      return &s.displacement;
+    case Field::velocity:
+      return &s.velocity;
+    case Field::pore_pressure:
+      return &s.pore_pressure;
+    case Field::darcy_velocity:
+      return &s.darcy_velocity;
+    case Field::effective_stress:
+      return &s.effective_stress;
+    case Field::total_stress:
+      return &s.total_stress;
+    case Field::strain:
+      return &s.strain;
+    case Field::porosity:
+      return &s.porosity;
   }
   return nullptr;
 }
@@ -305,32 +338,41 @@ void write_snapshot_vtu(const fs::path& path, const Snapshot& s) {
   AtomicFile file(path);
   std::ostream& out = file.stream();
   out << "<?xml version=\"1.0\"?>\n"
-         "<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">\n"
+         "<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" "
+         "header_type=\"UInt64\">\n"
          "  <UnstructuredGrid>\n"
          "    <FieldData>\n"
-         "      <DataArray type=\"Float64\" Name=\"TimeValue\" NumberOfTuples=\"1\" format=\"ascii\">";
+         "      <DataArray type=\"Float64\" Name=\"TimeValue\" NumberOfTuples=\"1\" "
+         "format=\"ascii\">";
   std::string t;
   append_number(t, s.time, false);
   out << t << "</DataArray>\n    </FieldData>\n";
-  out << "    <Piece NumberOfPoints=\"" << n << "\" NumberOfCells=\"" << n << "\">\n      <PointData>\n";
+  out << "    <Piece NumberOfPoints=\"" << n << "\" NumberOfCells=\"" << n
+      << "\">\n      <PointData>\n";
   for (Field f : s.fields) {
     if (f == Field::position) continue;  // the Points
     const std::vector<double>* a = snapshot_array(s, f);
     const int nc = field_components(f, 3);
     if (a == nullptr || a->size() != n * static_cast<std::size_t>(nc)) continue;
-    data_array<double>(out, "Float64", field_name(f), nc, n, [&](std::size_t i) { return (*a)[i]; });
+    data_array<double>(out, "Float64", field_name(f), nc, n,
+                       [&](std::size_t i) { return (*a)[i]; });
   }
   if (s.volume.size() == n)
     data_array<double>(out, "Float64", "volume", 1, n, [&](std::size_t i) { return s.volume[i]; });
   if (s.material.size() == n)
-    data_array<std::int32_t>(out, "Int32", "material", 1, n, [&](std::size_t i) { return s.material[i]; });
+    data_array<std::int32_t>(out, "Int32", "material", 1, n,
+                             [&](std::size_t i) { return s.material[i]; });
   out << "      </PointData>\n      <Points>\n";
   const bool have_points = s.position.size() == 3 * n;
-  data_array<double>(out, "Float64", "Points", 3, n, [&](std::size_t i) { return have_points ? s.position[i] : 0.0; });
+  data_array<double>(out, "Float64", "Points", 3, n,
+                     [&](std::size_t i) { return have_points ? s.position[i] : 0.0; });
   out << "      </Points>\n      <Cells>\n";
-  data_array<std::int64_t>(out, "Int64", "connectivity", 1, n, [](std::size_t i) { return static_cast<std::int64_t>(i); });
-  data_array<std::int64_t>(out, "Int64", "offsets", 1, n, [](std::size_t i) { return static_cast<std::int64_t>(i + 1); });
-  data_array<std::uint8_t>(out, "UInt8", "types", 1, n, [](std::size_t) { return std::uint8_t{1}; });  // VTK_VERTEX
+  data_array<std::int64_t>(out, "Int64", "connectivity", 1, n,
+                           [](std::size_t i) { return static_cast<std::int64_t>(i); });
+  data_array<std::int64_t>(out, "Int64", "offsets", 1, n,
+                           [](std::size_t i) { return static_cast<std::int64_t>(i + 1); });
+  data_array<std::uint8_t>(out, "UInt8", "types", 1, n,
+                           [](std::size_t) { return std::uint8_t{1}; });  // VTK_VERTEX
   out << "      </Cells>\n    </Piece>\n  </UnstructuredGrid>\n</VTKFile>\n";
   file.commit();
 }
@@ -338,12 +380,14 @@ void write_snapshot_vtu(const fs::path& path, const Snapshot& s) {
 void write_pvd(const fs::path& path, const std::vector<std::pair<double, std::string>>& entries) {
   AtomicFile file(path);
   std::ostream& out = file.stream();
-  out << "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"LittleEndian\">\n"
+  out << "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\" "
+         "byte_order=\"LittleEndian\">\n"
          "  <Collection>\n";
   for (const auto& [time, name] : entries) {
     std::string t;
     append_number(t, time, false);
-    out << "    <DataSet timestep=\"" << t << "\" group=\"\" part=\"0\" file=\"" << name << "\"/>\n";
+    out << "    <DataSet timestep=\"" << t << "\" group=\"\" part=\"0\" file=\"" << name
+        << "\"/>\n";
   }
   out << "  </Collection>\n</VTKFile>\n";
   file.commit();

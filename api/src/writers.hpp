@@ -42,8 +42,9 @@ void append_number(std::string& out, double v, bool json);
 /// summary.json: status, message, steps, end_time, dt, particles, nodes,
 /// solve_seconds, particle_steps_per_second, plus warnings, name,
 /// hmpm_version, state_bytes, cost and the list of files.
-void write_summary(const std::filesystem::path& path, const std::string& job_name, const RunResult& run,
-                   const CostEstimate& cost, const std::vector<std::string>& files);
+void write_summary(const std::filesystem::path& path, const std::string& job_name,
+                   const RunResult& run, const CostEstimate& cost,
+                   const std::vector<std::string>& files);
 
 /// series.json: {"time": [...], "particles": [{"index", "initial_position", <field>: rows}]}.
 void write_series_json(const std::filesystem::path& path, const Series& series);
@@ -57,7 +58,8 @@ void write_series_csv(const std::filesystem::path& path, const Series& series);
 void write_snapshot_vtu(const std::filesystem::path& path, const Snapshot& snapshot);
 
 /// ParaView collection listing (time, file name) pairs.
-void write_pvd(const std::filesystem::path& path, const std::vector<std::pair<double, std::string>>& entries);
+void write_pvd(const std::filesystem::path& path,
+               const std::vector<std::pair<double, std::string>>& entries);
 
 /// "snapshot_0007.vtu" for index 7.
 std::string snapshot_file_name(int index);

@@ -32,7 +32,8 @@ TEST(Cli, UsageErrorsExitOne) {
   EXPECT_EQ(run_command(hmpm_exe(), dir.path()).exit_code, 1);
   EXPECT_EQ(run_command(hmpm_exe() + " frobnicate", dir.path()).exit_code, 1);
   EXPECT_EQ(run_command(hmpm_exe() + " run x.json", dir.path()).exit_code, 1);  // no --out
-  EXPECT_EQ(run_command(hmpm_exe() + " run x.json --out o --threads zero", dir.path()).exit_code, 1);
+  EXPECT_EQ(run_command(hmpm_exe() + " run x.json --out o --threads zero", dir.path()).exit_code,
+            1);
   const auto r = run_command(hmpm_exe() + " validate /nonexistent/spec.json", dir.path());
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_NE(r.err.find("cannot read"), std::string::npos);
@@ -41,8 +42,10 @@ TEST(Cli, UsageErrorsExitOne) {
 TEST(Cli, ValidateExamplesExitZero) {
   testing::TempDir dir;
   for (const char* name : {"bar-vibration", "darcy-flow", "terzaghi"}) {
-    const auto r = run_command(hmpm_exe() + " validate '" + source_path(std::string("examples/") + name + ".json").string() + "'",
-                               dir.path());
+    const auto r =
+        run_command(hmpm_exe() + " validate '" +
+                        source_path(std::string("examples/") + name + ".json").string() + "'",
+                    dir.path());
     EXPECT_EQ(r.exit_code, 0) << name << ": " << r.err;
     EXPECT_TRUE(r.err.empty()) << r.err;
     EXPECT_NE(r.out.find("particles"), std::string::npos);
@@ -53,7 +56,8 @@ TEST(Cli, SpecFromStandardInput) {
   testing::TempDir dir;
   const std::string spec = source_path("examples/bar-vibration.json").string();
   EXPECT_EQ(run_command(hmpm_exe() + " validate - < '" + spec + "'", dir.path()).exit_code, 0);
-  const auto r = run_command("echo '{\"dimension\": 9}' | " + hmpm_exe() + " validate -", dir.path());
+  const auto r =
+      run_command("echo '{\"dimension\": 9}' | " + hmpm_exe() + " validate -", dir.path());
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.err.find("/dimension: "), std::string::npos);
   EXPECT_NE(r.err.find("/time: is required"), std::string::npos);
@@ -65,8 +69,9 @@ TEST(Cli, RunWithInvalidSpecExitsTwoAndWritesNothing) {
   testing::write_text(spec, R"json({"dimension": 1, "grid": {"min": [0], "max": [1], "cells": [4]},
     "materials": {"m": {"model": "linear_elastic", "density": 1, "youngs_modulus": -1, "poisson_ratio": 0}},
     "bodies": [{"material": "m", "box": {"min": [0], "max": [1]}}], "time": {"end": 1}})json");
-  const auto r = run_command(hmpm_exe() + " run '" + spec.string() + "' --out '" + (dir.path() / "out").string() + "'",
-                             dir.path());
+  const auto r = run_command(
+      hmpm_exe() + " run '" + spec.string() + "' --out '" + (dir.path() / "out").string() + "'",
+      dir.path());
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_EQ(r.err, "/materials/m/youngs_modulus: is -1; must be > 0\n");
   EXPECT_FALSE(fs::exists(dir.path() / "out"));
@@ -75,12 +80,14 @@ TEST(Cli, RunWithInvalidSpecExitsTwoAndWritesNothing) {
 TEST(Cli, RunWritesResultsAndExitsZero) {
   testing::TempDir dir;
   const auto out = dir.path() / "out";
-  const auto r = run_command(hmpm_exe() + " run '" + source_path("examples/bar-vibration.json").string() +
-                                 "' --out '" + out.string() + "' --threads 1",
-                             dir.path());
+  const auto r =
+      run_command(hmpm_exe() + " run '" + source_path("examples/bar-vibration.json").string() +
+                      "' --out '" + out.string() + "' --threads 1",
+                  dir.path());
   EXPECT_EQ(r.exit_code, 0) << r.err;
   EXPECT_TRUE(r.err.empty()) << "no progress bar when stderr is not a terminal: " << r.err;
-  for (const char* f : {"summary.json", "series.json", "series.csv", "snapshots.pvd", "snapshot_0000.vtu"})
+  for (const char* f :
+       {"summary.json", "series.json", "series.csv", "snapshots.pvd", "snapshot_0000.vtu"})
     EXPECT_TRUE(fs::exists(out / f)) << f;
   const json summary = json::parse(testing::read_text(out / "summary.json"));
   EXPECT_EQ(summary["status"], "successful");
@@ -99,7 +106,8 @@ TEST(Cli, FailedRunExitsThreeWithTheReason) {
                 "initial": {"velocity": [1e4]}}],
     "time": {"end": 1, "dt": 0.01}})json");
   const auto out = dir.path() / "out";
-  const auto r = run_command(hmpm_exe() + " run '" + spec.string() + "' --out '" + out.string() + "'", dir.path());
+  const auto r = run_command(
+      hmpm_exe() + " run '" + spec.string() + "' --out '" + out.string() + "'", dir.path());
   EXPECT_EQ(r.exit_code, 3) << r.out << r.err;
   ASSERT_TRUE(fs::exists(out / "summary.json"));
   const json summary = json::parse(testing::read_text(out / "summary.json"));

@@ -23,9 +23,9 @@ using testing::source_path;
 
 struct Mutation {
   const char* name;
-  const char* pointer;        ///< where to change the valid spec
-  const char* value;          ///< new JSON value; nullptr removes the key
-  const char* expected_path;  ///< an error must have exactly this pointer
+  const char* pointer;            ///< where to change the valid spec
+  const char* value;              ///< new JSON value; nullptr removes the key
+  const char* expected_path;      ///< an error must have exactly this pointer
   const char* message_part = "";  ///< ... and its message must contain this
 };
 
@@ -38,80 +38,97 @@ const Mutation kMutations[] = {
     {"grid_cells_fraction", "/grid/cells/1", "2.5", "/grid/cells/1", "integer"},
     {"grid_max_below_min", "/grid/max/0", "0", "/grid/max/0", "greater than grid min"},
     {"grid_min_length", "/grid/min", "[0, 0, 0]", "/grid/min", "expected 2"},
-    {"youngs_negative", "/materials/sand/youngs_modulus", "-1", "/materials/sand/youngs_modulus", "must be > 0"},
+    {"youngs_negative", "/materials/sand/youngs_modulus", "-1", "/materials/sand/youngs_modulus",
+     "must be > 0"},
     {"youngs_typo", "/materials/sand/youngs_modulu", "1e7", "/materials/sand/youngs_modulu",
      "did you mean 'youngs_modulus'?"},
-    {"poisson_half", "/materials/sand/poisson_ratio", "0.5", "/materials/sand/poisson_ratio", "(-1, 0.5)"},
-    {"porosity_above_one", "/materials/sand/hydraulic/porosity", "1.2", "/materials/sand/hydraulic/porosity",
-     "(0, 1)"},
-    {"porosity_zero", "/materials/sand/hydraulic/porosity", "0", "/materials/sand/hydraulic/porosity", "(0, 1)"},
-    {"unknown_model", "/materials/sand/model", "\"elastic\"", "/materials/sand/model", "'linear_elastic'"},
-    {"missing_friction_angle", "/materials/sand/friction_angle", nullptr, "/materials/sand/friction_angle",
-     "required for model 'mohr_coulomb'"},
+    {"poisson_half", "/materials/sand/poisson_ratio", "0.5", "/materials/sand/poisson_ratio",
+     "(-1, 0.5)"},
+    {"porosity_above_one", "/materials/sand/hydraulic/porosity", "1.2",
+     "/materials/sand/hydraulic/porosity", "(0, 1)"},
+    {"porosity_zero", "/materials/sand/hydraulic/porosity", "0",
+     "/materials/sand/hydraulic/porosity", "(0, 1)"},
+    {"unknown_model", "/materials/sand/model", "\"elastic\"", "/materials/sand/model",
+     "'linear_elastic'"},
+    {"missing_friction_angle", "/materials/sand/friction_angle", nullptr,
+     "/materials/sand/friction_angle", "required for model 'mohr_coulomb'"},
     {"plastic_key_on_elastic", "/materials/a~1b~0c/cohesion", "5", "/materials/a~1b~0c/cohesion",
      "only to models"},
     {"escaped_material_name_type", "/materials/a~1b~0c/youngs_modulus", "\"big\"",
      "/materials/a~1b~0c/youngs_modulus", "got string"},
-    {"dilatancy_above_friction", "/materials/sand/dilatancy_angle", "40", "/materials/sand/dilatancy_angle",
-     "friction_angle"},
-    {"density_boolean", "/materials/sand/density", "true", "/materials/sand/density", "got boolean"},
+    {"dilatancy_above_friction", "/materials/sand/dilatancy_angle", "40",
+     "/materials/sand/dilatancy_angle", "friction_angle"},
+    {"density_boolean", "/materials/sand/density", "true", "/materials/sand/density",
+     "got boolean"},
     {"missing_hydraulic_key", "/materials/sand/hydraulic/fluid_bulk_modulus", nullptr,
      "/materials/sand/hydraulic/fluid_bulk_modulus", "is required"},
     {"materials_empty", "/materials", "{}", "/materials", "at least one material"},
-    {"unknown_material", "/bodies/0/material", "\"clay\"", "/bodies/0/material", "unknown material 'clay'"},
-    {"body_box_outside_grid", "/bodies/0/box/max/0", "2", "/bodies/0/box/max/0", "outside the grid"},
+    {"unknown_material", "/bodies/0/material", "\"clay\"", "/bodies/0/material",
+     "unknown material 'clay'"},
+    {"body_box_outside_grid", "/bodies/0/box/max/0", "2", "/bodies/0/box/max/0",
+     "outside the grid"},
     {"body_box_length", "/bodies/0/box/min", "[0]", "/bodies/0/box/min", "expected 2"},
     {"bodies_empty", "/bodies", "[]", "/bodies", "at least one body"},
-    {"body_box_without_whole_cell", "/bodies/1/box", R"({"min": [0, 0.5], "max": [0.1, 0.6]})", "/bodies/1/box",
-     "no whole grid cell"},
-    {"particles_per_cell_zero", "/bodies/0/particles_per_cell", "0", "/bodies/0/particles_per_cell", "[1, 10]"},
-    {"bad_expression", "/bodies/0/initial/velocity/1", "\"0.1*sin(\"", "/bodies/0/initial/velocity/1",
-     "bad formula"},
-    {"time_in_initial_field", "/bodies/0/initial/pore_pressure", "\"2*t\"", "/bodies/0/initial/pore_pressure",
-     "x, y, z"},
-    {"assignment_in_expression", "/bodies/0/initial/velocity/0", "\"x=1\"", "/bodies/0/initial/velocity/0",
-     "assignment"},
+    {"body_box_without_whole_cell", "/bodies/1/box", R"({"min": [0, 0.5], "max": [0.1, 0.6]})",
+     "/bodies/1/box", "no whole grid cell"},
+    {"particles_per_cell_zero", "/bodies/0/particles_per_cell", "0", "/bodies/0/particles_per_cell",
+     "[1, 10]"},
+    {"bad_expression", "/bodies/0/initial/velocity/1", "\"0.1*sin(\"",
+     "/bodies/0/initial/velocity/1", "bad formula"},
+    {"time_in_initial_field", "/bodies/0/initial/pore_pressure", "\"2*t\"",
+     "/bodies/0/initial/pore_pressure", "x, y, z"},
+    {"assignment_in_expression", "/bodies/0/initial/velocity/0", "\"x=1\"",
+     "/bodies/0/initial/velocity/0", "assignment"},
     {"formula_not_finite_at_a_particle", "/bodies/0/initial/pore_pressure", "\"log(x - 0.5)\"",
-     "/bodies/0/initial/pore_pressure", "the formula gives nan at a particle of body 0 (x = 0.0625, y = 0.0625)"},
-    {"time_formula_not_finite", "/tractions/0/traction/1", "\"1/(t - 0.005)\"", "/tractions/0/traction/1",
-     "the formula gives inf at t = 0.005 s"},
-    {"initial_velocity_length", "/bodies/0/initial/velocity", "[0]", "/bodies/0/initial/velocity", "expected 2"},
+     "/bodies/0/initial/pore_pressure",
+     "the formula gives nan at a particle of body 0 (x = 0.0625, y = 0.0625)"},
+    {"time_formula_not_finite", "/tractions/0/traction/1", "\"1/(t - 0.005)\"",
+     "/tractions/0/traction/1", "the formula gives inf at t = 0.005 s"},
+    {"initial_velocity_length", "/bodies/0/initial/velocity", "[0]", "/bodies/0/initial/velocity",
+     "expected 2"},
     {"effective_stress_length", "/bodies/0/initial/effective_stress", "[0, 0, 0]",
      "/bodies/0/initial/effective_stress", "6"},
     {"pore_pressure_on_dry_material", "/bodies/1/initial", R"({"pore_pressure": 5})",
      "/bodies/1/initial/pore_pressure", "no 'hydraulic'"},
-    {"boundary_time_expression_uses_x", "/boundaries/2/pore_pressure", "\"x+1\"", "/boundaries/2/pore_pressure",
-     "bad formula"},
-    {"boundary_velocity_length", "/boundaries/0/velocity", "[0, 0, 0]", "/boundaries/0/velocity", "expected 2"},
-    {"boundary_nodes_word", "/boundaries/0/nodes", "\"everything\"", "/boundaries/0/nodes", "\"all\""},
+    {"boundary_time_expression_uses_x", "/boundaries/2/pore_pressure", "\"x+1\"",
+     "/boundaries/2/pore_pressure", "bad formula"},
+    {"boundary_velocity_length", "/boundaries/0/velocity", "[0, 0, 0]", "/boundaries/0/velocity",
+     "expected 2"},
+    {"boundary_nodes_word", "/boundaries/0/nodes", "\"everything\"", "/boundaries/0/nodes",
+     "\"all\""},
     {"boundary_without_condition", "/boundaries/0/velocity", nullptr, "/boundaries/0", "velocity"},
-    {"boundary_box_without_nodes", "/boundaries/0/nodes/box", R"({"min": [0.1, 0.1], "max": [0.2, 0.2]})",
-     "/boundaries/0/nodes/box", "no grid node"},
+    {"boundary_box_without_nodes", "/boundaries/0/nodes/box",
+     R"({"min": [0.1, 0.1], "max": [0.2, 0.2]})", "/boundaries/0/nodes/box", "no grid node"},
     {"traction_face_unknown", "/tractions/0/face", "\"w+\"", "/tractions/0/face", "'x-'"},
     {"traction_face_z_in_2d", "/tractions/0/face", "\"z+\"", "/tractions/0/face", "no z axis"},
-    {"traction_selects_nothing", "/tractions/0/particles/box", R"({"min": [0, 0.74], "max": [1, 0.75]})",
-     "/tractions/0/particles", "no particle"},
+    {"traction_selects_nothing", "/tractions/0/particles/box",
+     R"({"min": [0, 0.74], "max": [1, 0.75]})", "/tractions/0/particles", "no particle"},
     {"time_end_negative", "/time/end", "-1", "/time/end", "must be > 0"},
     {"time_dt_unstable", "/time/dt", "1", "/time/dt", "stable limit"},
     {"courant_above_one", "/time/courant", "1.5", "/time/courant", "(0, 1]"},
-    {"series_particle_out_of_range", "/output/series/particles/0", "1000", "/output/series/particles/0",
-     "48 particles"},
-    {"series_particle_negative", "/output/series/particles/0", "-1", "/output/series/particles/0", "integer"},
-    {"series_field_unknown", "/output/series/fields/1", "\"stress\"", "/output/series/fields/1", "'effective_stress'"},
-    {"series_field_twice", "/output/series/fields/1", "\"displacement\"", "/output/series/fields/1", "twice"},
-    {"near_wrong_length", "/output/series/particles/1/near", "[0.5]", "/output/series/particles/1/near",
-     "expected 2"},
+    {"series_particle_out_of_range", "/output/series/particles/0", "1000",
+     "/output/series/particles/0", "48 particles"},
+    {"series_particle_negative", "/output/series/particles/0", "-1", "/output/series/particles/0",
+     "integer"},
+    {"series_field_unknown", "/output/series/fields/1", "\"stress\"", "/output/series/fields/1",
+     "'effective_stress'"},
+    {"series_field_twice", "/output/series/fields/1", "\"displacement\"", "/output/series/fields/1",
+     "twice"},
+    {"near_wrong_length", "/output/series/particles/1/near", "[0.5]",
+     "/output/series/particles/1/near", "expected 2"},
     {"output_key_typo", "/output/snapshot", "{}", "/output/snapshot", "did you mean 'snapshots'?"},
     {"name_not_string", "/name", "3", "/name", "expected a string"},
     {"gravity_length", "/gravity", "[-9.81]", "/gravity", "expected 2"},
     {"shape_function_unknown", "/shape_function", "\"quadratic\"", "/shape_function", "'bspline'"},
     {"local_damping_one", "/local_damping", "1", "/local_damping", "[0, 1)"},
     {"limit_steps", "/time/end", "1e6", "/time/end", "the limit is 20000000"},
-    {"limit_cells", "/grid/cells", "[3000, 3000]", "/grid/cells", "9000000 cells; the limit is 4000000"},
+    {"limit_cells", "/grid/cells", "[3000, 3000]", "/grid/cells",
+     "9000000 cells; the limit is 4000000"},
     {"limit_particles", "/bodies/0/particles_per_cell", "10", "/bodies", "the limit is 2000000"},
     {"limit_snapshots", "/output/snapshots/interval", "1e-6", "/output/snapshots/interval",
      "10001 snapshots; the limit is 1000"},
-    {"limit_series_rows", "/output/series/interval", "1e-9", "/output/series/interval", "the limit is 1000000"},
+    {"limit_series_rows", "/output/series/interval", "1e-9", "/output/series/interval",
+     "the limit is 1000000"},
 };
 
 // limit_particles needs a grid fine enough: 1000 x 1000 cells, 10 x 10 each.
@@ -145,11 +162,13 @@ std::vector<RawCase> raw_cases() {
       {"truncated", valid.substr(0, valid.size() / 2), "", "not valid JSON"},
       {"root_is_array", "[1, 2]", "", "expected an object"},
       {"deep_nesting", std::string(100000, '['), "", "nested deeper than 64"},
-      {"deep_objects", [] {
+      {"deep_objects",
+       [] {
          std::string s;
          for (int i = 0; i < 100000; ++i) s += "{\"a\":";
          return s;
-       }(), "", "nested deeper"},
+       }(),
+       "", "nested deeper"},
       {"non_finite_number", overflow, "/time/end", "finite"},
       {"trailing_garbage", valid + "}", "", "not valid JSON"},
       {"duplicate_key", "{\"time\": {\"end\": 1, \"end\": 2}}", "/time/end", "duplicate key 'end'"},
@@ -179,13 +198,15 @@ TEST(MalformedSpecs, ParseJobReportsTheExactPointer) {
     EXPECT_FALSE(r.ok());
     EXPECT_FALSE(r.job.has_value());
     EXPECT_TRUE(has_error(r, m.expected_path, m.message_part))
-        << "want " << m.expected_path << " with '" << m.message_part << "', got\n" << listing(r);
+        << "want " << m.expected_path << " with '" << m.message_part << "', got\n"
+        << listing(r);
   }
   for (const RawCase& c : raw_cases()) {
     SCOPED_TRACE(c.name);
     const ParseResult r = parse_job(c.text);
     EXPECT_TRUE(has_error(r, c.expected_path, c.message_part))
-        << "want '" << c.expected_path << "' with '" << c.message_part << "', got\n" << listing(r);
+        << "want '" << c.expected_path << "' with '" << c.message_part << "', got\n"
+        << listing(r);
   }
 }
 
@@ -213,13 +234,15 @@ TEST(MalformedSpecs, ErrorListIsCappedAtAThousand) {
 TEST(MalformedSpecs, ValidationWorkIsBounded) {
   // 13 bodies on a 1D grid of 4 million cells: laying them out is refused
   // before any per-cell loop runs.
-  json spec = json::parse(R"json({"dimension": 1, "grid": {"min": [0], "max": [1], "cells": [4000000]},
+  json spec =
+      json::parse(R"json({"dimension": 1, "grid": {"min": [0], "max": [1], "cells": [4000000]},
     "materials": {"m": {"model": "linear_elastic", "density": 1, "youngs_modulus": 1, "poisson_ratio": 0}},
     "bodies": [], "time": {"end": 1}})json");
   for (int i = 0; i < 13; ++i)
     spec["bodies"].push_back({{"material", "m"}, {"box", {{"min", {0.0}}, {"max", {1e-6}}}}});
   const ParseResult r = parse_job(spec.dump());
-  EXPECT_TRUE(has_error(r, "/bodies", "too much work to lay out (52000000 > 50000000)")) << listing(r);
+  EXPECT_TRUE(has_error(r, "/bodies", "too much work to lay out (52000000 > 50000000)"))
+      << listing(r);
 }
 
 TEST(MalformedSpecs, LimitsAreConfigurable) {
@@ -244,7 +267,8 @@ TEST(MalformedSpecs, CommandLineExitsTwoWithPointerLines) {
     SCOPED_TRACE(name);
     const auto spec = dir.path() / (name + ".json");
     testing::write_text(spec, text);
-    const auto r = testing::run_command(testing::hmpm_exe() + " validate '" + spec.string() + "'", dir.path());
+    const auto r =
+        testing::run_command(testing::hmpm_exe() + " validate '" + spec.string() + "'", dir.path());
     EXPECT_EQ(r.exit_code, 2) << r.err;
     EXPECT_NE(("\n" + r.err).find("\n" + path + ": "), std::string::npos) << r.err;
   };

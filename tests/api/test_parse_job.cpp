@@ -53,7 +53,7 @@ TEST(ParseJob, RoundTripOfEveryField) {
   EXPECT_DOUBLE_EQ(sand.hydraulic->porosity, 0.3);
   EXPECT_DOUBLE_EQ(sand.hydraulic->hydraulic_conductivity, 1e-3);
   EXPECT_DOUBLE_EQ(sand.hydraulic->fluid_bulk_modulus, 2.2e9);
-  EXPECT_DOUBLE_EQ(sand.hydraulic->fluid_density, 1000);  // default
+  EXPECT_DOUBLE_EQ(sand.hydraulic->fluid_density, 1000);        // default
   EXPECT_TRUE(std::isinf(sand.hydraulic->solid_bulk_modulus));  // default: incompressible grains
   EXPECT_TRUE(std::holds_alternative<LinearElastic>(other.plasticity));
   EXPECT_FALSE(other.hydraulic.has_value());
@@ -97,8 +97,8 @@ TEST(ParseJob, RoundTripOfEveryField) {
   ASSERT_EQ(p.output.series_particles.size(), 2u);
   EXPECT_EQ(p.output.series_particles[0], 0);
   EXPECT_EQ(p.output.series_particles[1], nearest_particle(p, {0.5, 0.25, 0}));
-  EXPECT_EQ(p.output.series_fields,
-            (std::vector<Field>{Field::displacement, Field::pore_pressure, Field::effective_stress}));
+  EXPECT_EQ(p.output.series_fields, (std::vector<Field>{Field::displacement, Field::pore_pressure,
+                                                        Field::effective_stress}));
   EXPECT_DOUBLE_EQ(p.output.series_interval, 0.001);
   EXPECT_DOUBLE_EQ(p.output.snapshot_interval, 0.005);
   // position is added: it is the VTU Points.
@@ -118,7 +118,8 @@ TEST(ParseJob, RoundTripOfEveryField) {
 }
 
 TEST(ParseJob, DefaultsOfTheContract) {
-  const ParsedJob job = parse_valid(R"json({"dimension": 1, "grid": {"min": [0], "max": [1], "cells": [10]},
+  const ParsedJob job =
+      parse_valid(R"json({"dimension": 1, "grid": {"min": [0], "max": [1], "cells": [10]},
     "materials": {"m": {"model": "linear_elastic", "density": 1, "youngs_modulus": 1, "poisson_ratio": 0}},
     "bodies": [{"material": "m", "box": {"min": [0], "max": [1]}}], "time": {"end": 1}})json");
   const Problem& p = job.problem;
@@ -166,7 +167,8 @@ TEST(ParseJob, ShapeFunctionsModelsAndAllSelections) {
 TEST(ParseJob, EveryExampleIsValid) {
   for (const char* name : {"bar-vibration", "darcy-flow", "terzaghi"}) {
     SCOPED_TRACE(name);
-    const ParseResult r = parse_job(read_text(source_path(std::string("examples/") + name + ".json")));
+    const ParseResult r =
+        parse_job(read_text(source_path(std::string("examples/") + name + ".json")));
     for (const auto& e : r.errors) ADD_FAILURE() << e.path << ": " << e.message;
     ASSERT_TRUE(r.job.has_value());
     EXPECT_EQ(r.job->name, name);
@@ -188,7 +190,8 @@ TEST(ParseJob, KnownKeysTableCoversTheTopLevel) {
   ASSERT_FALSE(table.empty());
   EXPECT_EQ(table.front().location, "");
   const auto& top = table.front().keys;
-  for (const char* key : {"name", "dimension", "grid", "materials", "bodies", "time", "output", "description"})
+  for (const char* key :
+       {"name", "dimension", "grid", "materials", "bodies", "time", "output", "description"})
     EXPECT_NE(std::find(top.begin(), top.end(), key), top.end()) << key;
 }
 

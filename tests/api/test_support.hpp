@@ -35,7 +35,8 @@ class TempDir {
  public:
   TempDir() {
     const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    std::string name = std::string("hmpm-api-") + (info ? info->test_suite_name() + std::string("-") + info->name() : "x");
+    std::string name = std::string("hmpm-api-") +
+                       (info ? info->test_suite_name() + std::string("-") + info->name() : "x");
     for (char& c : name)
       if (c == '/') c = '_';
     path_ = std::filesystem::temp_directory_path() / name;
@@ -71,11 +72,14 @@ inline CommandResult run_command(const std::string& command, const std::filesyst
 }
 
 /// The built command line, quoted for the shell.
-inline std::string hmpm_exe() { return std::string("'") + HMPM_EXE + "'"; }
+inline std::string hmpm_exe() {
+  return std::string("'") + HMPM_EXE + "'";
+}
 
 /// The Python interpreter with meshio/numpy (scripts/python.sh), quoted.
 inline std::string python_exe(const std::filesystem::path& scratch) {
-  const CommandResult r = run_command("bash '" + source_path("scripts/python.sh").string() + "'", scratch);
+  const CommandResult r =
+      run_command("bash '" + source_path("scripts/python.sh").string() + "'", scratch);
   std::string py = r.out;
   while (!py.empty() && (py.back() == '\n' || py.back() == '\r')) py.pop_back();
   return "'" + py + "'";

@@ -85,7 +85,8 @@ TEST(Writers, OneDimensionalVectorsAreStillArrays) {
   testing::TempDir dir;
   write_series_json(dir.path() / "series.json", s);
   const json j = json::parse(testing::read_text(dir.path() / "series.json"));
-  EXPECT_EQ(j["particles"][0]["displacement"], json::parse("[[0.25], [0.5]]"));  // contract: [[ux], ...]
+  EXPECT_EQ(j["particles"][0]["displacement"],
+            json::parse("[[0.25], [0.5]]"));  // contract: [[ux], ...]
   EXPECT_EQ(j["particles"][0]["pore_pressure"], json::parse("[7.0, 8.0]"));
   EXPECT_EQ(j["particles"][0]["initial_position"], json::parse("[0.5]"));
 }
@@ -95,7 +96,9 @@ TEST(Writers, SeriesCsvMatchesJson) {
   write_series_csv(dir.path() / "series.csv", synthetic_series());
   const std::string csv = testing::read_text(dir.path() / "series.csv");
   const std::string header = csv.substr(0, csv.find('\n'));
-  EXPECT_EQ(header.rfind("time,p4_displacement_x,p4_displacement_y,p4_pore_pressure,p4_strain_xx,", 0), 0u)
+  EXPECT_EQ(
+      header.rfind("time,p4_displacement_x,p4_displacement_y,p4_pore_pressure,p4_strain_xx,", 0),
+      0u)
       << header;
   EXPECT_NE(header.find(",p9_strain_zx"), std::string::npos);
   EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 4);  // header + 3 rows
@@ -129,17 +132,22 @@ TEST(Writers, SnapshotsReadBackWithMeshio) {
   write_summary(dir.path() / "summary.json", "synthetic", run, CostEstimate{}, {});
   EXPECT_EQ(snapshot_file_name(12), "snapshot_0012.vtu");
   const std::string py = testing::python_exe(dir.path());
-  const auto r = testing::run_command(
-      "bash -c " + std::string("\"") + py + " '" + testing::source_path("tests/api/check_results.py").string() +
-          "' '" + dir.path().string() + "' --particles 7 --require-snapshots --snapshot-fields velocity,pore_pressure,effective_stress\"",
-      fs::temp_directory_path());
+  const auto r =
+      testing::run_command("bash -c " + std::string("\"") + py + " '" +
+                               testing::source_path("tests/api/check_results.py").string() + "' '" +
+                               dir.path().string() +
+                               "' --particles 7 --require-snapshots --snapshot-fields "
+                               "velocity,pore_pressure,effective_stress\"",
+                           fs::temp_directory_path());
   EXPECT_EQ(r.exit_code, 0) << r.out << r.err;
   // Exact values through meshio.
-  const std::string probe = py + " -c \"import meshio; m = meshio.read('" + (dir.path() / "snapshot_0002.vtu").string() +
-                            "'); print(m.points[3].tolist(), m.point_data['effective_stress'][3].tolist(), "
-                            "m.point_data['material'].tolist(), m.point_data['pore_pressure'][6])\"";
+  const std::string probe =
+      py + " -c \"import meshio; m = meshio.read('" + (dir.path() / "snapshot_0002.vtu").string() +
+      "'); print(m.points[3].tolist(), m.point_data['effective_stress'][3].tolist(), "
+      "m.point_data['material'].tolist(), m.point_data['pore_pressure'][6])\"";
   const auto v = testing::run_command(probe, fs::temp_directory_path());
-  EXPECT_EQ(v.out, "[3.0, 6.0, 0.0] [-3.0, -6.0, -9.0, -12.0, -15.0, -18.0] [0, 1, 0, 1, 0, 1, 0] 106.0\n")
+  EXPECT_EQ(v.out,
+            "[3.0, 6.0, 0.0] [-3.0, -6.0, -9.0, -12.0, -15.0, -18.0] [0, 1, 0, 1, 0, 1, 0] 106.0\n")
       << v.err;
 }
 
@@ -155,15 +163,17 @@ TEST(Writers, UnwritableDirectoryThrows) {
 }
 
 TEST(RunJob, WritesEveryRequestedFileAndASummary) {
-  const ParseResult parsed = parse_job(testing::read_text(testing::source_path("tests/api/data/valid-2d.json")));
+  const ParseResult parsed =
+      parse_job(testing::read_text(testing::source_path("tests/api/data/valid-2d.json")));
   ASSERT_TRUE(parsed.job);
   testing::TempDir dir;
   const JobOutcome out = run_job(*parsed.job, dir.path() / "results");
   for (const std::string& f : out.files) EXPECT_TRUE(fs::exists(dir.path() / "results" / f)) << f;
   EXPECT_NE(std::find(out.files.begin(), out.files.end(), "summary.json"), out.files.end());
   const json summary = json::parse(testing::read_text(dir.path() / "results" / "summary.json"));
-  for (const char* key : {"status", "message", "steps", "end_time", "dt", "particles", "nodes", "solve_seconds",
-                          "particle_steps_per_second", "warnings", "cost", "name", "hmpm_version"})
+  for (const char* key :
+       {"status", "message", "steps", "end_time", "dt", "particles", "nodes", "solve_seconds",
+        "particle_steps_per_second", "warnings", "cost", "name", "hmpm_version"})
     EXPECT_TRUE(summary.contains(key)) << key;
   EXPECT_EQ(summary["name"], "valid-2d");
   EXPECT_EQ(summary["cost"]["particles"], 48);
@@ -173,7 +183,8 @@ TEST(RunJob, WritesEveryRequestedFileAndASummary) {
 }
 
 TEST(RunJob, FailedWriteStillLeavesASummaryAndThrows) {
-  const ParseResult parsed = parse_job(testing::read_text(testing::source_path("examples/bar-vibration.json")));
+  const ParseResult parsed =
+      parse_job(testing::read_text(testing::source_path("examples/bar-vibration.json")));
   ASSERT_TRUE(parsed.job);
   testing::TempDir dir;
   // A directory where the first snapshot file should go makes its rename fail.
