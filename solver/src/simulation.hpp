@@ -30,6 +30,8 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <memory>
+#include <mutex>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -37,6 +39,7 @@
 #include "hmpm/problem.hpp"
 #include "hmpm/run.hpp"
 #include "materials.hpp"
+#include "parallel.hpp"
 #include "particle_layout.hpp"
 #include "shape.hpp"
 #include "state.hpp"
@@ -190,22 +193,107 @@ class Simulation {
   /// Advances the state from t to t + dt. Sets failure_ on the first problem.
   void step(double t, double dt) {
     clear_grid();
-    map_particles_to_grid();
+    for_particles(kMass | kMomentum | kForce | (fluid_ ? kStorage | kPressure : 0u),
+                  [&](const Scatter& out, std::size_t b, std::size_t e) { map_particles_to_grid(out, b, e); });
     if (fluid_) {
       compute_nodal_pressure(t);
-      map_pore_pressure_force();
+      for_particles(kForce, [&](const Scatter& out, std::size_t b, std::size_t e) {
+        map_pore_pressure_force(out, b, e);
+      });
     }
     apply_tractions(t);
     update_nodal_momentum(t, dt);
-    update_particle_velocities_and_remap(dt);
+    for_particles(kRemap, [&](const Scatter& out, std::size_t b, std::size_t e) {
+      update_particle_velocities_and_remap(out, b, e, dt);
+    });
     compute_remapped_nodal_velocity(t + dt);
     if (fluid_) {
-      update_particle_stress_and_fluid_flux</*Move=*/false>(dt);
+      for_particles(kFlux, [&](const Scatter& out, std::size_t b, std::size_t e) {
+        update_particle_stress_and_fluid_flux</*Move=*/false>(out, b, e, dt);
+      });
       update_nodal_pressure(t + dt, dt);
-      update_particle_pressure_and_position(dt);
+      for_particles(0u, [&](const Scatter&, std::size_t b, std::size_t e) {
+        update_particle_pressure_and_position(b, e, dt);
+      });
     } else {
-      update_particle_stress_and_fluid_flux</*Move=*/true>(dt);
+      for_particles(0u, [&](const Scatter& out, std::size_t b, std::size_t e) {
+        update_particle_stress_and_fluid_flux</*Move=*/true>(out, b, e, dt);
+      });
     }
+  }
+
+  // ------------------------------------------------------------ threads
+  // Thread 0 accumulates nodal sums straight into the grid; every other
+  // thread into a private buffer that is added to the grid after the phase,
+  // buffers in thread order, so sums are reproducible for a thread count.
+  enum : unsigned { kMass = 1, kMomentum = 2, kForce = 4, kRemap = 8, kStorage = 16, kPressure = 32, kFlux = 64 };
+
+  struct Scatter {
+    double* mass;
+    Vec* momentum;
+    Vec* force;
+    Vec* remap;
+    double* storage;
+    double* pressure;
+    double* flux;
+  };
+
+  struct ScatterBuffer {
+    std::vector<double> mass, storage, pressure, flux;
+    std::vector<Vec> momentum, force, remap;
+  };
+
+  Scatter scatter_of(int t) {
+    if (t == 0)
+      return {grid_.mass.data(), grid_.momentum.data(), grid_.force.data(), grid_.remap.data(),
+              grid_.storage.data(), grid_.pressure.data(), grid_.flux.data()};
+    ScatterBuffer& b = buffers_[static_cast<std::size_t>(t - 1)];
+    return {b.mass.data(), b.momentum.data(), b.force.data(), b.remap.data(),
+            b.storage.data(), b.pressure.data(), b.flux.data()};
+  }
+
+  void setup_threads(int threads) {
+    pool_ = std::make_unique<ThreadPool>(threads);
+    buffers_.resize(static_cast<std::size_t>(threads - 1));
+    const auto n = static_cast<std::size_t>(grid_.count);
+    for (ScatterBuffer& b : buffers_) {
+      b.mass.resize(n); b.momentum.resize(n); b.force.resize(n); b.remap.resize(n);
+      if (fluid_) { b.storage.resize(n); b.pressure.resize(n); b.flux.resize(n); }
+    }
+  }
+
+  /// Runs phase(scatter, begin, end) over particle chunks, with the private
+  /// buffers of `fields` zeroed first and added to the grid after.
+  template <class Phase>
+  void for_particles(unsigned fields, Phase&& phase) {
+    auto chunk = [&](int t, std::size_t b, std::size_t e) {
+      if (t > 0 && fields) {
+        ScatterBuffer& buf = buffers_[static_cast<std::size_t>(t - 1)];
+        if (fields & kMass) std::fill(buf.mass.begin(), buf.mass.end(), 0.0);
+        if (fields & kMomentum) std::fill(buf.momentum.begin(), buf.momentum.end(), Vec::Zero());
+        if (fields & kForce) std::fill(buf.force.begin(), buf.force.end(), Vec::Zero());
+        if (fields & kRemap) std::fill(buf.remap.begin(), buf.remap.end(), Vec::Zero());
+        if (fields & kStorage) std::fill(buf.storage.begin(), buf.storage.end(), 0.0);
+        if (fields & kPressure) std::fill(buf.pressure.begin(), buf.pressure.end(), 0.0);
+        if (fields & kFlux) std::fill(buf.flux.begin(), buf.flux.end(), 0.0);
+      }
+      phase(scatter_of(t), b, e);
+    };
+    pool_->for_ranges(particles_.size(), chunk);
+    if (buffers_.empty() || !fields) return;
+    auto reduce = [&](int, std::size_t b, std::size_t e) {
+      for (const ScatterBuffer& buf : buffers_)
+        for (std::size_t i = b; i < e; ++i) {
+          if (fields & kMass) grid_.mass[i] += buf.mass[i];
+          if (fields & kMomentum) grid_.momentum[i] += buf.momentum[i];
+          if (fields & kForce) grid_.force[i] += buf.force[i];
+          if (fields & kRemap) grid_.remap[i] += buf.remap[i];
+          if (fields & kStorage) grid_.storage[i] += buf.storage[i];
+          if (fields & kPressure) grid_.pressure[i] += buf.pressure[i];
+          if (fields & kFlux) grid_.flux[i] += buf.flux[i];
+        }
+    };
+    pool_->for_ranges(static_cast<std::size_t>(grid_.count), reduce);
   }
 
   template <bool Grad = true>
@@ -242,9 +330,9 @@ class Simulation {
 
   /// Phase 1: mass, momentum, effective-stress and body forces, and the
   /// fluid storage and storage-weighted pressure, from particles to nodes.
-  void map_particles_to_grid() {
+  void map_particles_to_grid(const Scatter& out, std::size_t begin, std::size_t end) {
     StencilT s;
-    for (std::size_t p = 0; p < particles_.size(); ++p) {
+    for (std::size_t p = begin; p < end; ++p) {
       stencil_of(p, s);
       const double m = particles_.mass[p];
       const double vol = particles_.volume[p];
@@ -254,9 +342,9 @@ class Simulation {
       for (int k = 0; k < StencilT::N; ++k) {
         const std::int64_t i = s.node[k];
         const double w = s.w[k];
-        grid_.mass[i] += w * m;
-        grid_.momentum[i] += w * mv;
-        grid_.force[i] += w * mb - vol_sig * s.grad[k];
+        out.mass[i] += w * m;
+        out.momentum[i] += w * mv;
+        out.force[i] += w * mb - vol_sig * s.grad[k];
       }
       if (fluid_) {
         const std::uint16_t mat = particles_.material[p];
@@ -265,8 +353,8 @@ class Simulation {
         const double qv = ((1.0 - n) * inv_ks_[mat] + n * inv_kf_[mat]) * vol;
         const double qvp = qv * particles_.pressure[p];
         for (int k = 0; k < StencilT::N; ++k) {
-          grid_.storage[s.node[k]] += s.w[k] * qv;
-          grid_.pressure[s.node[k]] += s.w[k] * qvp;
+          out.storage[s.node[k]] += s.w[k] * qv;
+          out.pressure[s.node[k]] += s.w[k] * qvp;
         }
       }
     }
@@ -285,16 +373,16 @@ class Simulation {
 
   /// Phase 2 (saturated): the pore pressure interpolated from the nodes,
   /// p_hat = sum N_j p_j, enters the total stress: f_i += V p_hat grad N_i.
-  void map_pore_pressure_force() {
+  void map_pore_pressure_force(const Scatter& out, std::size_t begin, std::size_t end) {
     StencilT s;
-    for (std::size_t p = 0; p < particles_.size(); ++p) {
+    for (std::size_t p = begin; p < end; ++p) {
       if (!constants_[particles_.material[p]].saturated) continue;
       stencil_of(p, s);
       double p_hat = 0.0;
       for (int k = 0; k < StencilT::N; ++k) p_hat += s.w[k] * grid_.pressure[s.node[k]];
       const double vp = particles_.volume[p] * p_hat;
       for (int k = 0; k < StencilT::N; ++k)
-        grid_.force[s.node[k]] += vp * s.grad[k];
+        out.force[s.node[k]] += vp * s.grad[k];
     }
   }
 
@@ -354,16 +442,17 @@ class Simulation {
   /// re-mapping of the updated momentum (MUSL, Eq. 26). Saturated particles
   /// also compute their Darcy velocity here, where the nodal pressure
   /// gradient and the solid acceleration of this step are both at hand.
-  void update_particle_velocities_and_remap(double dt) {
+  void update_particle_velocities_and_remap(const Scatter& out, std::size_t begin, std::size_t end,
+                                            double dt) {
     StencilT s;
-    for (std::size_t p = 0; p < particles_.size(); ++p) {
+    for (std::size_t p = begin; p < end; ++p) {
       if (fluid_) stencil_of<true>(p, s);  // the Darcy velocity needs grad p
       else stencil_of<false>(p, s);
       Vec a = Vec::Zero();
       for (int k = 0; k < StencilT::N; ++k) a += s.w[k] * grid_.accel[s.node[k]];
       particles_.v[p] += dt * a;
       const Vec mv = particles_.mass[p] * particles_.v[p];
-      for (int k = 0; k < StencilT::N; ++k) grid_.remap[s.node[k]] += s.w[k] * mv;
+      for (int k = 0; k < StencilT::N; ++k) out.remap[s.node[k]] += s.w[k] * mv;
       if (fluid_) {
         const std::uint16_t mat = particles_.material[p];
         const MaterialConstants& mc = constants_[mat];
@@ -397,9 +486,10 @@ class Simulation {
   /// particles also move with the Lagrangian nodal velocity (dry runs; in
   /// saturated runs the last phase moves them).
   template <bool Move>
-  void update_particle_stress_and_fluid_flux(double dt) {
+  void update_particle_stress_and_fluid_flux(const Scatter& out, std::size_t begin, std::size_t end,
+                                             double dt) {
     StencilT s;
-    for (std::size_t p = 0; p < particles_.size(); ++p) {
+    for (std::size_t p = begin; p < end; ++p) {
       stencil_of(p, s);
       Mat grad_v = Mat::Zero();
       for (int k = 0; k < StencilT::N; ++k)
@@ -411,7 +501,7 @@ class Simulation {
         const double div_v = grad_v.trace();
         const Vec& w = particles_.darcy[p];
         for (int k = 0; k < StencilT::N; ++k)
-          grid_.flux[s.node[k]] +=
+          out.flux[s.node[k]] +=
               vol * (s.grad[k].dot(w) - s.w[k] * div_v);
       }
       Voigt de = Voigt::Zero();
@@ -447,9 +537,9 @@ class Simulation {
 
   /// Phase 5 (saturated): particle pressure state += sum N dp_i (FLIP);
   /// reported pressure = sum N p_i^{n+1}; particles move.
-  void update_particle_pressure_and_position(double dt) {
+  void update_particle_pressure_and_position(std::size_t begin, std::size_t end, double dt) {
     StencilT s;
-    for (std::size_t p = 0; p < particles_.size(); ++p) {
+    for (std::size_t p = begin; p < end; ++p) {
       stencil_of<false>(p, s);
       if (constants_[particles_.material[p]].saturated) {
         double dp = 0.0, p_new = 0.0;  // weights only: this pass needs no gradient
@@ -481,32 +571,36 @@ class Simulation {
   }
 
   // ------------------------------------------------------------ failures
-  // Called from hot loops only on the failure path; record the first one.
-  void fail_nonfinite(std::size_t p, const char* what) {
-    if (failed_) return;
+  // Called from hot loops only on the failure path. Threads may find
+  // failures in any order; the lowest particle index wins, so the report is
+  // the same for any thread count.
+  void record_failure(std::size_t p, std::string what, std::string hint) {
+    std::lock_guard<std::mutex> lock(failure_mutex_);
+    const auto index = static_cast<std::int64_t>(p);
+    if (failed_ && failure_particle_ <= index) return;
     failed_ = true;
-    failure_particle_ = static_cast<std::int64_t>(p);
-    failure_ = std::string("the ") + what + " became non-finite: the run diverged";
-    failure_hint_ = "reduce time.dt or time.courant (the stable step estimate is " +
-                    number(stable_.limit) + " s), and check moduli, densities and loads for "
-                    "unrealistic values";
+    failure_particle_ = index;
+    failure_ = std::move(what);
+    failure_hint_ = std::move(hint);
+  }
+  void fail_nonfinite(std::size_t p, const char* what) {
+    record_failure(p, std::string("the ") + what + " became non-finite: the run diverged",
+                   "reduce time.dt or time.courant (the stable step estimate is " +
+                       number(stable_.limit) + " s), and check moduli, densities and loads for "
+                       "unrealistic values");
   }
   void fail_left_grid(std::size_t p) {
-    if (failed_) return;
-    failed_ = true;
-    failure_particle_ = static_cast<std::int64_t>(p);
-    failure_ = "the particle left the grid";
-    failure_hint_ = "enlarge grid.min/grid.max so the grid contains the motion, or restrain the "
-                    "body with boundaries";
+    record_failure(p, "the particle left the grid",
+                   "enlarge grid.min/grid.max so the grid contains the motion, or restrain the "
+                   "body with boundaries");
   }
   void fail_volume(std::size_t p, double j) {
-    if (failed_) return;
-    failed_ = true;
-    failure_particle_ = static_cast<std::int64_t>(p);
-    failure_ = "the particle volume became " + std::string(j <= 0 ? "negative or zero" : "non-finite") +
-               " (volume ratio " + number(j) + " in one step)";
-    failure_hint_ = "reduce time.dt or time.courant, refine the grid, or use a gimp/bspline "
-                    "shape_function for large deformations";
+    record_failure(p,
+                   "the particle volume became " +
+                       std::string(j <= 0 ? "negative or zero" : "non-finite") +
+                       " (volume ratio " + number(j) + " in one step)",
+                   "reduce time.dt or time.courant, refine the grid, or use a gimp/bspline "
+                   "shape_function for large deformations");
   }
 
   static std::string number(double v) {
@@ -553,7 +647,11 @@ class Simulation {
   double mass_tolerance_ = 0.0;
   StableStep stable_;
 
-  bool failed_ = false;
+  std::unique_ptr<ThreadPool> pool_;
+  std::vector<ScatterBuffer> buffers_;
+
+  std::mutex failure_mutex_;
+  bool failed_ = false;  // written under failure_mutex_, read between phases
   std::int64_t failure_particle_ = -1;
   std::string failure_;
   std::string failure_hint_;

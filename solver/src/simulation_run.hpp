@@ -93,11 +93,20 @@ RunResult Simulation<Dim, Shape>::run(const RunOptions& options) {
   double min_mass = std::numeric_limits<double>::infinity();
   for (double m : particles_.mass) min_mass = std::min(min_mass, m);
   mass_tolerance_ = particles_.size() ? 1e-12 * min_mass : 0.0;
+  // Threads: every core when asked for <= 0, but at least
+  // min_particles_per_thread particles each.
+  int threads = options.threads > 0 ? options.threads
+                                    : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  threads = static_cast<int>(std::clamp<std::int64_t>(
+      static_cast<std::int64_t>(particles_.size()) / std::max<std::int64_t>(1, options.min_particles_per_thread),
+      1, threads));
+  setup_threads(threads);
 
   result.dt = dt;
   result.particles = static_cast<std::int64_t>(particles_.size());
   result.nodes = grid_.count;
-  result.state_bytes = particles_.bytes() + grid_.bytes();
+  result.state_bytes = particles_.bytes() + grid_.bytes() * threads;
+  result.threads = threads;
 
   // Output set-up.
   const OutputRequest& out = problem_.output;

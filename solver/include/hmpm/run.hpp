@@ -101,6 +101,9 @@ struct Series {
 
 struct RunOptions {
   int threads = 1;  ///< solver threads; <= 0 means every core
+  /// Fewer particles than this per thread and the run uses fewer threads:
+  /// below it thread dispatch costs more than it saves.
+  std::int64_t min_particles_per_thread = 20000;
   /// Called about every `progress_interval_s` seconds of wall time, and once at the end.
   std::function<void(const Progress&)> on_progress;
   double progress_interval_s = 0.5;
@@ -127,6 +130,7 @@ struct RunResult {
   double solve_seconds = 0.0;  ///< wall time of the time loop only
   double particle_steps_per_second = 0.0;
   std::int64_t state_bytes = 0;  ///< particle + grid state in memory
+  int threads = 1;               ///< solver threads actually used
   Series series;
 };
 

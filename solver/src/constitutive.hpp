@@ -1,0 +1,386 @@
+// constitutive.hpp — stress-point algorithms for perfectly plastic soils (internal).
+//
+// The explicit time step updates each particle's effective stress with an
+// elastic predictor (the full strain increment through linear isotropic
+// elasticity) and then calls one of the functions here to bring the trial
+// stress back onto the yield surface. Both models are perfectly plastic and
+// have linear yield functions in their natural stress coordinates, so the
+// return is closed form: no iteration, no allocation, no virtual call and no
+// exception, which is what a per-particle, per-step routine must be.
+//
+//  * Mohr-Coulomb works in principal stress space (closed-form 3x3 spectral
+//    decomposition). Non-associated flow with dilatancy psi, a tension
+//    cut-off on the major principal stress, and returns to the main plane,
+//    to the triaxial compression and extension edges and to the apex, chosen
+//    by the closed-form region tests of the multi-plane algorithm (Clausen,
+//    Damkilde & Andersen 2006/2007; derived here, not copied).
+//  * Drucker-Prager works with (p, sqrt(J2)): return to the cone, to the
+//    tension cut-off on the mean stress, or to the corner/apex where the two
+//    meet. No spectral decomposition.
+//
+// Conventions: stress as Voigt xx, yy, zz, xy, yz, zx (tensor components),
+// Pa, compression negative (effective stress for saturated soils: the caller
+// passes sigma' and adds the pore pressure itself). Principal stresses are
+// ordered algebraically s1 >= s2 >= s3, so s3 is the most compressive.
+// Dilatancy angles are clamped into [0, phi]: psi > phi is unphysical and
+// psi < 0 (contractive flow) is not supported by the region tests.
+//
+// Each return function reports ||d eps_p||, the Frobenius norm of the plastic
+// strain increment. For a single smooth surface this is the plastic
+// multiplier of the unit-normalised plastic potential; it is also the
+// increment of the usual accumulated plastic strain, and 0 exactly when the
+// step was elastic (the stress is then left bitwise untouched).
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/Eigenvalues>
+#include <Eigen/LU>
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <tuple>
+#include <type_traits>
+
+#include "hmpm/problem.hpp"
+
+namespace hmpm::constitutive {
+
+using Voigt = Eigen::Matrix<double, 6, 1>;
+
+/// Linear isotropic elasticity: Lame's lambda and the shear modulus G, Pa (G > 0).
+struct Elastic {
+  double lambda;
+  double shear;
+};
+
+/// A linear yield plane in ordered principal stress space:
+/// f = normal . s - offset, plastic flow along `flow` (dg/ds).
+struct PrincipalPlane {
+  Eigen::Vector3d normal;
+  Eigen::Vector3d flow;
+  double offset;
+};
+
+/// Mohr-Coulomb constants, computed once per material by make_mohr_coulomb.
+/// In ordered principal stresses (s1 >= s2 >= s3, compression negative):
+///   f  = (1 + sin phi) s1 - (1 - sin phi) s3 - 2 c cos phi
+///   g  = (1 + sin psi) s1 - (1 - sin psi) s3
+///   ft = s1 - tension_cutoff
+struct MohrCoulombConstants {
+  double sin_phi = 0.0;
+  double cos_phi = 1.0;
+  double sin_psi = 0.0;   ///< of the clamped dilatancy angle
+  double cohesion = 0.0;  ///< c, Pa
+  double apex = std::numeric_limits<double>::infinity();  ///< c cot phi, Pa; +inf when phi = 0
+  double tension_cutoff = 0.0;  ///< sigma_t = min(max(tensile_strength, 0), c cot phi), Pa
+  /// The planes a return can activate, in this order: the main plane F1
+  /// (s1, s3); F2 (s2, s3), which meets F1 on the triaxial compression edge
+  /// s1 = s2; F3 (s1, s2), which meets F1 on the triaxial extension edge
+  /// s2 = s3; then the cut-off planes s1, s2, s3 <= sigma_t (associated).
+  std::array<PrincipalPlane, 6> planes;
+};
+
+/// Drucker-Prager constants, computed once per material by make_drucker_prager.
+/// With p = tr(sigma)/3 (negative in compression) and J2 = s:s/2:
+///   f  = sqrt(J2) + alpha p - k          (alpha >= 0: compression strengthens)
+///   g  = sqrt(J2) + alpha_psi p
+///   ft = p - mean_tension_cutoff
+struct DruckerPragerConstants {
+  double alpha = 0.0;
+  double k = 0.0;  ///< Pa
+  double alpha_psi = 0.0;
+  double mean_tension_cutoff = 0.0;  ///< p_t = min(max(tensile_strength, 0), k/alpha), Pa
+};
+
+namespace detail {
+
+constexpr double deg_to_rad = 3.14159265358979323846 / 180.0;
+
+/// D b for the isotropic stiffness in principal space: lambda tr(b) 1 + 2G b.
+inline Eigen::Vector3d stiffness_times(const Elastic& el, const Eigen::Vector3d& b) {
+  return Eigen::Vector3d::Constant(el.lambda * b.sum()) + 2.0 * el.shear * b;
+}
+
+/// C^-1 x (compliance) in principal space: x/(2G) - lambda/(2G(3 lambda + 2G)) tr(x) 1.
+inline Eigen::Vector3d compliance_times(const Elastic& el, const Eigen::Vector3d& x) {
+  const double two_g = 2.0 * el.shear;
+  return x / two_g -
+         Eigen::Vector3d::Constant(el.lambda / (two_g * (3.0 * el.lambda + two_g)) * x.sum());
+}
+
+/// Solves the closed-form return onto the intersection of the M planes in
+/// `active`: s = trial - sum_j dl_j D b_j with f_i(s) = 0 for every active i.
+/// Returns false when the planes are (numerically) dependent. dl receives the
+/// multipliers.
+template <int M>
+bool solve_active(const std::array<int, M>& active, const Eigen::Vector3d& trial,
+                  const Elastic& el, const std::array<PrincipalPlane, 6>& planes,
+                  Eigen::Vector3d& out, Eigen::Matrix<double, M, 1>& dl) {
+  Eigen::Matrix<double, M, M> a;
+  Eigen::Matrix<double, M, 1> rhs;
+  Eigen::Matrix<double, 3, M> corrector;
+  for (int j = 0; j < M; ++j) corrector.col(j) = stiffness_times(el, planes[active[j]].flow);
+  for (int i = 0; i < M; ++i) {
+    const PrincipalPlane& pl = planes[active[i]];
+    rhs(i) = pl.normal.dot(trial) - pl.offset;
+    for (int j = 0; j < M; ++j) a(i, j) = pl.normal.dot(corrector.col(j));
+  }
+  const double scale = a.cwiseAbs().maxCoeff();
+  const double det = a.determinant();
+  if (!(std::abs(det) > 1e-12 * std::pow(scale, M))) return false;
+  dl = a.inverse() * rhs;
+  out = trial - corrector * dl;
+  return true;
+}
+
+/// Energy distance (trial - s) : C^-1 : (trial - s) in principal space.
+inline double energy_distance(const Elastic& el, const Eigen::Vector3d& trial,
+                              const Eigen::Vector3d& s) {
+  const Eigen::Vector3d d = trial - s;
+  return d.dot(compliance_times(el, d));
+}
+
+/// Closed-form Mohr-Coulomb return in ordered principal stresses (s1 >= s2 >= s3).
+/// `trial` must violate f or the cut-off. Returns the principal stresses on
+/// or inside the yield surface; `tol` (Pa) absorbs rounding in region tests.
+inline Eigen::Vector3d mohr_coulomb_principal(const Eigen::Vector3d& trial, const Elastic& el,
+                                              const MohrCoulombConstants& mc, double tol) {
+  const auto& pl = mc.planes;
+  const auto f_main = [&](const Eigen::Vector3d& s) { return pl[0].normal.dot(s) - pl[0].offset; };
+  const auto ordered = [&](const Eigen::Vector3d& s) {
+    return s(0) >= s(1) - tol && s(1) >= s(2) - tol;
+  };
+  const double dl_tol = -tol / (2.0 * el.shear);  // multipliers are strains: f / stiffness
+
+  // Stage 1: Mohr-Coulomb alone (main plane, edges, apex).
+  Eigen::Vector3d mc_stress = trial;
+  bool found = f_main(trial) <= tol;  // only the cut-off is violated
+  if (!found) {
+    Eigen::Vector3d plane;
+    Eigen::Matrix<double, 1, 1> dl1;
+    solve_active<1>({0}, trial, el, pl, plane, dl1);  // always solvable: a.Db > 0
+    if (ordered(plane)) {
+      mc_stress = plane;
+      found = true;
+    }
+    Eigen::Matrix<double, 2, 1> dl2;
+    Eigen::Vector3d edge;
+    // Plane return overshooting s1 >= s2: triaxial compression edge s1 = s2.
+    if (!found && plane(0) < plane(1) && solve_active<2>({0, 1}, trial, el, pl, edge, dl2) &&
+        dl2.minCoeff() >= dl_tol && edge(1) >= edge(2) - tol) {
+      mc_stress = edge;
+      found = true;
+    }
+    // Plane return overshooting s2 >= s3: triaxial extension edge s2 = s3.
+    if (!found && plane(1) < plane(2) && solve_active<2>({0, 2}, trial, el, pl, edge, dl2) &&
+        dl2.minCoeff() >= dl_tol && edge(0) >= edge(1) - tol) {
+      mc_stress = edge;
+      found = true;
+    }
+    if (!found) {
+      if (std::isfinite(mc.apex)) {
+        // Beyond both edges' apex planes: the apex. No multiplier test here:
+        // with psi < phi the flow cone of the sextant's three planes does not
+        // contain the hydrostatic axis, yet the apex is the return there.
+        mc_stress = Eigen::Vector3d::Constant(mc.apex);
+      } else {
+        // Tresca (no apex): only rounding can get here; take whichever edge
+        // return is admissible and nearer in the energy norm.
+        double best = std::numeric_limits<double>::infinity();
+        for (int partner = 1; partner <= 2; ++partner) {
+          if (!solve_active<2>({0, partner}, trial, el, pl, edge, dl2) || !ordered(edge)) continue;
+          const double d = energy_distance(el, trial, edge);
+          if (d < best) best = d, mc_stress = edge;
+        }
+        if (!std::isfinite(best)) mc_stress = plane;
+      }
+    }
+  }
+  if (mc_stress(0) <= mc.tension_cutoff + tol) return mc_stress;
+
+  // Stage 2: the cut-off is active (only when sigma_t < c cot phi). Try the
+  // active sets that contain s1 <= sigma_t, from planes to corners; accept
+  // the first with non-negative multipliers whose stress is admissible. If
+  // non-associated flow leaves a gap, take the nearest admissible candidate
+  // in the energy norm (the cut-off apex (sigma_t, sigma_t, sigma_t) always is).
+  const auto admissible = [&](const Eigen::Vector3d& s) {
+    return ordered(s) && f_main(s) <= tol && s(0) <= mc.tension_cutoff + tol;
+  };
+  Eigen::Vector3d best_stress = Eigen::Vector3d::Constant(mc.tension_cutoff);
+  double best = energy_distance(el, trial, best_stress);
+  Eigen::Vector3d s;
+  const auto attempt = [&](const auto& set) {
+    constexpr int m = static_cast<int>(std::tuple_size_v<std::decay_t<decltype(set)>>);
+    Eigen::Matrix<double, m, 1> dl;
+    if (!solve_active<m>(set, trial, el, pl, s, dl) || !admissible(s)) return false;
+    if (dl.minCoeff() >= dl_tol) return true;
+    const double d = energy_distance(el, trial, s);
+    if (d < best) best = d, best_stress = s;
+    return false;
+  };
+  if (attempt(std::array{3}) || attempt(std::array{0, 3}) || attempt(std::array{3, 4})) return s;
+  // Corner on the extension edge: s1 = sigma_t, s2 = s3 on F1.
+  if (attempt(std::array{0, 2, 3})) return s;
+  // Corner on the compression edge: s1 = s2 = sigma_t, s3 on F1. Four planes
+  // meet there; its flow cone is the union of the cones of any three.
+  if (attempt(std::array{0, 3, 4}) || attempt(std::array{1, 3, 4}) ||
+      attempt(std::array{0, 1, 3}) || attempt(std::array{0, 1, 4})) {
+    return s;
+  }
+  if (attempt(std::array{3, 4, 5})) return Eigen::Vector3d::Constant(mc.tension_cutoff);  // exact
+  return best_stress;
+}
+
+/// Voigt stress -> symmetric 3x3 tensor.
+inline Eigen::Matrix3d to_tensor(const Voigt& v) {
+  Eigen::Matrix3d m;
+  m << v(0), v(3), v(5), v(3), v(1), v(4), v(5), v(4), v(2);
+  return m;
+}
+
+}  // namespace detail
+
+/// Precomputes the Mohr-Coulomb constants of `m` (angles in degrees, c and
+/// tensile_strength in Pa). The dilatancy angle is clamped into [0, phi]; the
+/// cut-off is sigma_t = min(max(tensile_strength, 0), c cot phi), so the
+/// default tensile_strength = 0 means "no tension" (and sigma_t is the apex
+/// when c = 0). phi = 0 gives Tresca with no apex.
+inline MohrCoulombConstants make_mohr_coulomb(const hmpm::MohrCoulomb& m) {
+  MohrCoulombConstants c;
+  const double phi = std::clamp(m.friction_angle_deg, 0.0, 89.0) * detail::deg_to_rad;
+  const double psi = std::clamp(m.dilatancy_angle_deg, 0.0, phi / detail::deg_to_rad) *
+                     detail::deg_to_rad;
+  c.sin_phi = std::sin(phi);
+  c.cos_phi = std::cos(phi);
+  c.sin_psi = std::sin(psi);
+  c.cohesion = std::max(m.cohesion, 0.0);
+  c.apex = c.sin_phi > 0.0 ? c.cohesion * c.cos_phi / c.sin_phi
+                           : std::numeric_limits<double>::infinity();
+  c.tension_cutoff = std::min(std::max(m.tensile_strength, 0.0), c.apex);
+  const double sp = c.sin_phi, ss = c.sin_psi, k = 2.0 * c.cohesion * c.cos_phi;
+  c.planes[0] = {{1 + sp, 0, -(1 - sp)}, {1 + ss, 0, -(1 - ss)}, k};
+  c.planes[1] = {{0, 1 + sp, -(1 - sp)}, {0, 1 + ss, -(1 - ss)}, k};
+  c.planes[2] = {{1 + sp, -(1 - sp), 0}, {1 + ss, -(1 - ss), 0}, k};
+  for (int i = 0; i < 3; ++i) {
+    c.planes[3 + i].normal = Eigen::Vector3d::Unit(i);
+    c.planes[3 + i].flow = Eigen::Vector3d::Unit(i);
+    c.planes[3 + i].offset = c.tension_cutoff;
+  }
+  return c;
+}
+
+/// Precomputes the Drucker-Prager constants of `m` (angles in degrees, Pa).
+/// Plane-strain match to Mohr-Coulomb (the classical fit, exact for
+/// associated flow in plane strain at the limit state, d eps_zz^p = 0):
+///   alpha = 3 tan phi / sqrt(9 + 12 tan^2 phi),  k = 3 c / sqrt(9 + 12 tan^2 phi),
+///   alpha_psi = the same expression in psi (clamped into [0, phi]).
+/// The mean-stress cut-off is p_t = min(max(tensile_strength, 0), k/alpha).
+inline DruckerPragerConstants make_drucker_prager(const hmpm::DruckerPrager& m) {
+  DruckerPragerConstants c;
+  const double phi = std::clamp(m.friction_angle_deg, 0.0, 89.0) * detail::deg_to_rad;
+  const double psi = std::clamp(m.dilatancy_angle_deg, 0.0, phi / detail::deg_to_rad) *
+                     detail::deg_to_rad;
+  const double tp = std::tan(phi), ts = std::tan(psi);
+  const double root = std::sqrt(9.0 + 12.0 * tp * tp);
+  c.alpha = 3.0 * tp / root;
+  c.k = 3.0 * std::max(m.cohesion, 0.0) / root;
+  c.alpha_psi = 3.0 * ts / std::sqrt(9.0 + 12.0 * ts * ts);
+  const double apex = c.alpha > 0.0 ? c.k / c.alpha : std::numeric_limits<double>::infinity();
+  c.mean_tension_cutoff = std::min(std::max(m.tensile_strength, 0.0), apex);
+  return c;
+}
+
+/// Mohr-Coulomb return mapping. `stress` holds the elastic trial stress
+/// (Voigt, Pa, compression negative) on entry and the returned stress on
+/// exit; `el` is the elasticity that made the trial. Elastic trials are
+/// detected from p and J2 alone when possible, then from the principal
+/// stresses, and are left bitwise untouched. A plastic trial is decomposed
+/// (closed-form 3x3 eigen solver), returned in principal space and rotated
+/// back with the same eigenvectors (a hydrostatic result is set exactly).
+/// Returns ||d eps_p|| >= 0 (0 if elastic). Never throws, never allocates.
+inline double return_mohr_coulomb(Voigt& stress, const Elastic& el,
+                                  const MohrCoulombConstants& mc) {
+  // Cheap elastic test: with s the deviator, s1 - s3 <= 2 sqrt(J2),
+  // s1 + s3 = 2p - s2 <= 2p + sqrt(J2/3) and s1 <= p + 2 sqrt(J2/3).
+  const double p = (stress(0) + stress(1) + stress(2)) / 3.0;
+  const double dx = stress(0) - p, dy = stress(1) - p, dz = stress(2) - p;
+  const double j2 = 0.5 * (dx * dx + dy * dy + dz * dz) + stress(3) * stress(3) +
+                    stress(4) * stress(4) + stress(5) * stress(5);
+  const double q = std::sqrt(j2), q3 = std::sqrt(j2 / 3.0);
+  const double two_c_cos = 2.0 * mc.cohesion * mc.cos_phi;
+  if (2.0 * q + mc.sin_phi * (2.0 * p + q3) - two_c_cos <= 0.0 &&
+      p + 2.0 * q3 <= mc.tension_cutoff) {
+    return 0.0;
+  }
+
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig;
+  eig.computeDirect(detail::to_tensor(stress));
+  const Eigen::Vector3d& ev = eig.eigenvalues();  // ascending
+  const Eigen::Vector3d trial(ev(2), ev(1), ev(0));  // s1 >= s2 >= s3
+  const double f = mc.planes[0].normal.dot(trial) - mc.planes[0].offset;
+  if (f <= 0.0 && trial(0) <= mc.tension_cutoff) return 0.0;
+
+  const double scale = trial.cwiseAbs().maxCoeff() + mc.cohesion;
+  const Eigen::Vector3d r = detail::mohr_coulomb_principal(trial, el, mc, 1e-13 * scale);
+
+  if (r(0) == r(1) && r(1) == r(2)) {
+    stress << r(0), r(0), r(0), 0.0, 0.0, 0.0;
+  } else {
+    const Eigen::Matrix3d& v = eig.eigenvectors();
+    const Eigen::Matrix3d m = v * Eigen::Vector3d(r(2), r(1), r(0)).asDiagonal() * v.transpose();
+    stress << m(0, 0), m(1, 1), m(2, 2), 0.5 * (m(0, 1) + m(1, 0)), 0.5 * (m(1, 2) + m(2, 1)),
+        0.5 * (m(0, 2) + m(2, 0));
+  }
+  return detail::compliance_times(el, trial - r).norm();
+}
+
+/// Drucker-Prager return mapping. `stress` holds the elastic trial stress
+/// (Voigt, Pa, compression negative) on entry and the returned stress on
+/// exit. In (p, sqrt(J2)) the return is: to the cone along
+/// (K alpha_psi, G) when that lands at p <= p_t with sqrt(J2) >= 0; else to
+/// the cut-off p = p_t with the deviator kept, if that is inside the cone;
+/// else to the corner p = p_t, sqrt(J2) = k - alpha p_t (the apex when
+/// p_t = k/alpha). The deviator keeps its direction throughout. Elastic
+/// trials are left bitwise untouched. Returns ||d eps_p|| >= 0 (0 if elastic).
+inline double return_drucker_prager(Voigt& stress, const Elastic& el,
+                                    const DruckerPragerConstants& dp) {
+  const double p = (stress(0) + stress(1) + stress(2)) / 3.0;
+  const double dx = stress(0) - p, dy = stress(1) - p, dz = stress(2) - p;
+  const double q = std::sqrt(0.5 * (dx * dx + dy * dy + dz * dz) + stress(3) * stress(3) +
+                             stress(4) * stress(4) + stress(5) * stress(5));
+  const double f = q + dp.alpha * p - dp.k;
+  const double pt = dp.mean_tension_cutoff;
+  if (f <= 0.0 && p <= pt) return 0.0;
+
+  const double g = el.shear, bulk = el.lambda + 2.0 * g / 3.0;
+  const double tol = 1e-13 * (std::abs(p) + q + dp.k);
+  double p_new = pt, q_new = q;
+  bool done = false;
+  if (f > 0.0) {  // cone
+    const double dl = f / (g + bulk * dp.alpha * dp.alpha_psi);
+    const double qc = q - g * dl, pc = p - bulk * dp.alpha_psi * dl;
+    if (qc >= 0.0 && pc <= pt + tol) {
+      p_new = pc;
+      q_new = qc;
+      done = true;
+    }
+  }
+  if (!done && !(p > pt && q + dp.alpha * pt - dp.k <= 0.0)) {
+    q_new = std::max(dp.k - dp.alpha * pt, 0.0);  // corner / apex
+  }
+  const double ratio = q > 0.0 ? q_new / q : 0.0;
+  if (q_new == 0.0) {
+    stress << p_new, p_new, p_new, 0.0, 0.0, 0.0;  // apex: exactly hydrostatic
+  } else if (q_new == q) {
+    stress.head<3>().array() += p_new - p;  // cut-off: deviator untouched
+  } else {
+    stress.head<3>() << p_new + ratio * dx, p_new + ratio * dy, p_new + ratio * dz;
+    stress.tail<3>() *= ratio;
+  }
+  const double dq = q - q_new, dpm = p - p_new;
+  // ||d eps_p||^2 = ||ds||^2/(4G^2) + 3 (dp/(3K))^2, with ||ds|| = sqrt(2) dq.
+  return std::sqrt(dq * dq / (2.0 * g * g) + dpm * dpm / (3.0 * bulk * bulk));
+}
+
+}  // namespace hmpm::constitutive
