@@ -70,8 +70,8 @@ struct PrincipalPlane {
 struct MohrCoulombConstants {
   double sin_phi = 0.0;
   double cos_phi = 1.0;
-  double sin_psi = 0.0;   ///< of the clamped dilatancy angle
-  double cohesion = 0.0;  ///< c, Pa
+  double sin_psi = 0.0;                                   ///< of the clamped dilatancy angle
+  double cohesion = 0.0;                                  ///< c, Pa
   double apex = std::numeric_limits<double>::infinity();  ///< c cot phi, Pa; +inf when phi = 0
   double tension_cutoff = 0.0;  ///< sigma_t = min(max(tensile_strength, 0), c cot phi), Pa
   /// The planes a return can activate, in this order: the main plane F1
@@ -114,9 +114,9 @@ inline Eigen::Vector3d compliance_times(const Elastic& el, const Eigen::Vector3d
 /// Returns false when the planes are (numerically) dependent. dl receives the
 /// multipliers.
 template <int M>
-bool solve_active(const std::array<int, M>& active, const Eigen::Vector3d& trial,
-                  const Elastic& el, const std::array<PrincipalPlane, 6>& planes,
-                  Eigen::Vector3d& out, Eigen::Matrix<double, M, 1>& dl) {
+bool solve_active(const std::array<int, M>& active, const Eigen::Vector3d& trial, const Elastic& el,
+                  const std::array<PrincipalPlane, 6>& planes, Eigen::Vector3d& out,
+                  Eigen::Matrix<double, M, 1>& dl) {
   Eigen::Matrix<double, M, M> a;
   Eigen::Matrix<double, M, 1> rhs;
   Eigen::Matrix<double, 3, M> corrector;
@@ -249,8 +249,8 @@ inline Eigen::Matrix3d to_tensor(const Voigt& v) {
 inline MohrCoulombConstants make_mohr_coulomb(const hmpm::MohrCoulomb& m) {
   MohrCoulombConstants c;
   const double phi = std::clamp(m.friction_angle_deg, 0.0, 89.0) * detail::deg_to_rad;
-  const double psi = std::clamp(m.dilatancy_angle_deg, 0.0, phi / detail::deg_to_rad) *
-                     detail::deg_to_rad;
+  const double psi =
+      std::clamp(m.dilatancy_angle_deg, 0.0, phi / detail::deg_to_rad) * detail::deg_to_rad;
   c.sin_phi = std::sin(phi);
   c.cos_phi = std::cos(phi);
   c.sin_psi = std::sin(psi);
@@ -279,8 +279,8 @@ inline MohrCoulombConstants make_mohr_coulomb(const hmpm::MohrCoulomb& m) {
 inline DruckerPragerConstants make_drucker_prager(const hmpm::DruckerPrager& m) {
   DruckerPragerConstants c;
   const double phi = std::clamp(m.friction_angle_deg, 0.0, 89.0) * detail::deg_to_rad;
-  const double psi = std::clamp(m.dilatancy_angle_deg, 0.0, phi / detail::deg_to_rad) *
-                     detail::deg_to_rad;
+  const double psi =
+      std::clamp(m.dilatancy_angle_deg, 0.0, phi / detail::deg_to_rad) * detail::deg_to_rad;
   const double tp = std::tan(phi), ts = std::tan(psi);
   const double root = std::sqrt(9.0 + 12.0 * tp * tp);
   c.alpha = 3.0 * tp / root;
@@ -316,7 +316,7 @@ inline double return_mohr_coulomb(Voigt& stress, const Elastic& el,
 
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig;
   eig.computeDirect(detail::to_tensor(stress));
-  const Eigen::Vector3d& ev = eig.eigenvalues();  // ascending
+  const Eigen::Vector3d& ev = eig.eigenvalues();     // ascending
   const Eigen::Vector3d trial(ev(2), ev(1), ev(0));  // s1 >= s2 >= s3
   const double f = mc.planes[0].normal.dot(trial) - mc.planes[0].offset;
   if (f <= 0.0 && trial(0) <= mc.tension_cutoff) return 0.0;
