@@ -102,9 +102,15 @@ template <int Dim, class Shape>
 struct Stencil {
   static constexpr int K = Shape::K;
   static constexpr int N = Dim == 1 ? K : (Dim == 2 ? K * K : K * K * K);
-  std::array<std::int64_t, N> node;
-  std::array<double, N> w;
+  std::array<std::int64_t, N> node{};
+  std::array<double, N> w{};
   std::array<Eigen::Matrix<double, Dim, 1>, N> grad;
+
+  // Zeroed once per phase (not per particle): weights-only passes leave the
+  // gradients untouched, and Eigen types are not value-initialised.
+  Stencil() {
+    for (auto& g : grad) g.setZero();
+  }
 
   /// x: particle position; origin, inv_h: grid; cells, stride: per axis.
   /// With Grad = false only node indices and weights are filled (passes that
