@@ -226,6 +226,15 @@ class JobStore::Lease {
 };
 
 JobStore::JobStore(const std::filesystem::path& db_path) : path_(db_path) {
+  try {
+    migrate();
+  } catch (...) {
+    close_idle();  // the destructor will not run
+    throw;
+  }
+}
+
+void JobStore::migrate() {
   auto lease_ = lease();
   sqlite3* db = lease_.get();
   WriteTransaction tx(db);
@@ -243,10 +252,13 @@ JobStore::JobStore(const std::filesystem::path& db_path) : path_(db_path) {
   tx.commit();
 }
 
-JobStore::~JobStore() {
+void JobStore::close_idle() {
+  std::lock_guard<std::mutex> lock(pool_mutex_);
   for (sqlite3* db : idle_) sqlite3_close(db);
+  idle_.clear();
 }
 
+JobStore::~JobStore() { close_idle(); }
 int JobStore::current_schema_version() { return static_cast<int>(migrations.size()); }
 
 sqlite3* JobStore::open_connection() {

@@ -173,6 +173,8 @@ class JobStore {
  private:
   class Lease;
   Lease lease();
+  void migrate();
+  void close_idle();
   sqlite3* open_connection();
   void release(sqlite3* db);
 
