@@ -7,7 +7,8 @@
 namespace hmpm::server {
 
 std::string format_rfc3339(std::chrono::system_clock::time_point t) {
-  const auto ms = std::chrono::duration_cast<std::chrono::milliseconds>(t.time_since_epoch()).count();
+  const auto ms =
+      std::chrono::duration_cast<std::chrono::milliseconds>(t.time_since_epoch()).count();
   const std::time_t seconds = static_cast<std::time_t>(ms / 1000);
   std::tm utc{};
   gmtime_r(&seconds, &utc);
@@ -18,6 +19,8 @@ std::string format_rfc3339(std::chrono::system_clock::time_point t) {
   return text;
 }
 
-std::string now_rfc3339() { return format_rfc3339(std::chrono::system_clock::now()); }
+std::string now_rfc3339() {
+  return format_rfc3339(std::chrono::system_clock::now());
+}
 
 }  // namespace hmpm::server

@@ -100,7 +100,9 @@ Json link(const std::string& href, const char* rel, const char* type, const char
   return Json{{"href", href}, {"rel", rel}, {"type", type}, {"title", title}};
 }
 
-Json timestamp_or_null(const std::string& t) { return t.empty() ? Json(nullptr) : Json(t); }
+Json timestamp_or_null(const std::string& t) {
+  return t.empty() ? Json(nullptr) : Json(t);
+}
 
 int whole_percent(double progress) {
   return static_cast<int>(std::clamp(std::floor(progress), 0.0, 100.0));
@@ -139,9 +141,14 @@ Json status_document(const JobRecord& job) {
 }
 
 JobCost cost_of(const hmpm::api::CostEstimate& c) {
-  return JobCost{.particles = c.particles, .nodes = c.nodes, .cells = c.cells, .steps = c.steps,
-                 .particle_steps = c.particle_steps, .memory_bytes = c.memory_bytes,
-                 .output_bytes = c.output_bytes, .dt = c.dt};
+  return JobCost{.particles = c.particles,
+                 .nodes = c.nodes,
+                 .cells = c.cells,
+                 .steps = c.steps,
+                 .particle_steps = c.particle_steps,
+                 .memory_bytes = c.memory_bytes,
+                 .output_bytes = c.output_bytes,
+                 .dt = c.dt};
 }
 
 // Compares without an early exit, so the time taken does not reveal how
@@ -212,15 +219,18 @@ ServiceConfig resolved(ServiceConfig c) {
     const int cores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
     c.threads_per_job = std::max(1, cores / std::max(1, c.workers));
   }
-  if (!c.db_path.parent_path().empty()) std::filesystem::create_directories(c.db_path.parent_path());
+  if (!c.db_path.parent_path().empty())
+    std::filesystem::create_directories(c.db_path.parent_path());
   std::filesystem::create_directories(c.data_dir);
   return c;
 }
 
 WorkerSettings worker_settings(const ServiceConfig& c, const hmpm::api::Limits& limits) {
-  return WorkerSettings{.workers = c.workers, .threads_per_job = c.threads_per_job,
+  return WorkerSettings{.workers = c.workers,
+                        .threads_per_job = c.threads_per_job,
                         .wall_time_limit_s = c.job_wall_time_s,
-                        .progress_interval_s = c.progress_interval_s, .data_dir = c.data_dir,
+                        .progress_interval_s = c.progress_interval_s,
+                        .data_dir = c.data_dir,
                         .limits = limits};
 }
 
@@ -242,7 +252,10 @@ Service::Impl::Impl(ServiceConfig c)
     log_line({{"event", "job"}, {"job", id}, {"status", "accepted"}, {"recovered", true}});
   }
   for (const auto& id : recovery.failed) {
-    log_line({{"event", "job"}, {"job", id}, {"status", "failed"}, {"recovered", true},
+    log_line({{"event", "job"},
+              {"job", id},
+              {"status", "failed"},
+              {"recovered", true},
               {"reason", "too many interrupted attempts"}});
   }
   install_routes();
@@ -343,10 +356,14 @@ void Service::Impl::install_routes() {
 
   http.set_logger([this](const Request& req, const Response& res) {
     metrics.count_request(res.status);
-    Json line{{"event", "request"}, {"method", req.method}, {"path", req.path},
-              {"status", res.status}, {"remote", req.remote_addr}};
+    Json line{{"event", "request"},
+              {"method", req.method},
+              {"path", req.path},
+              {"status", res.status},
+              {"remote", req.remote_addr}};
     if (request_timed) {
-      line["ms"] = std::chrono::duration<double, std::milli>(SteadyClock::now() - request_start).count();
+      line["ms"] =
+          std::chrono::duration<double, std::milli>(SteadyClock::now() - request_start).count();
       request_timed = false;
     }
     log_line(std::move(line));
@@ -357,23 +374,24 @@ void Service::Impl::install_routes() {
       store.schema_version();
       send_json(res, 200, Json{{"status", "ok"}});
     } catch (const std::exception&) {
-      send_json(res, 503, Json{{"status", "unavailable"}, {"detail", "the database cannot be read"}});
+      send_json(res, 503,
+                Json{{"status", "unavailable"}, {"detail", "the database cannot be read"}});
     }
   });
   http.Get("/metrics", guarded([this](const Request&, Response& res) {
              res.set_content(metrics.render(store.count_by_status(), config.workers),
                              "text/plain; version=0.0.4; charset=utf-8");
            }));
-  http.Post("/jobs", [this](const Request& req, Response& res, const httplib::ContentReader& reader) {
-    post_job(req, res, reader);
-  });
+  http.Post("/jobs", [this](const Request& req, Response& res,
+                            const httplib::ContentReader& reader) { post_job(req, res, reader); });
   http.Get("/jobs", guarded([this](const Request& req, Response& res) { list_jobs(req, res); }));
   const std::string job = std::string("/jobs/") + uuid_pattern;
   http.Get(job, guarded([this](const Request& req, Response& res) { get_job(req, res); }));
   http.Delete(job, guarded([this](const Request& req, Response& res) { dismiss_job(req, res); }));
   http.Get(job + "/spec", guarded([this](const Request& req, Response& res) {
              const auto found = store.find(req.matches[1]);
-             if (!found) return send_not_found(res, "no job with id " + std::string(req.matches[1]));
+             if (!found)
+               return send_not_found(res, "no job with id " + std::string(req.matches[1]));
              res.set_content(found->spec, "application/json");  // exactly the bytes submitted
            }));
   http.Get(job + "/results",
@@ -397,7 +415,8 @@ void Service::Impl::install_routes() {
   http.Delete(".*", fallback);
 }
 
-void Service::Impl::post_job(const Request& req, Response& res, const httplib::ContentReader& reader) {
+void Service::Impl::post_job(const Request& req, Response& res,
+                             const httplib::ContentReader& reader) {
   std::string body;
   bool too_large = false;
   const bool complete = reader([&](const char* data, std::size_t n) {
@@ -410,10 +429,12 @@ void Service::Impl::post_job(const Request& req, Response& res, const httplib::C
   });
   if (!complete) {
     if (too_large || res.status == 413) {
-      return send_problem(res, 413, "payload-too-large", "Payload too large",
-                          "the job spec exceeds " + std::to_string(config.max_body_bytes) + " bytes");
+      return send_problem(
+          res, 413, "payload-too-large", "Payload too large",
+          "the job spec exceeds " + std::to_string(config.max_body_bytes) + " bytes");
     }
-    return send_problem(res, 400, "bad-request", "Bad request", "the request body could not be read");
+    return send_problem(res, 400, "bad-request", "Bad request",
+                        "the request body could not be read");
   }
   if (!authorized(req)) return send_unauthorized(res);
   if (stopping) {
@@ -437,7 +458,8 @@ void Service::Impl::post_job(const Request& req, Response& res, const httplib::C
     const std::string detail = std::to_string(parsed.errors.size()) +
                                (parsed.errors.size() == 1 ? " problem" : " problems") +
                                " in the job spec; see errors";
-    return send_problem(res, 400, "invalid-spec", "Invalid job spec", detail, Json{{"errors", errors}});
+    return send_problem(res, 400, "invalid-spec", "Invalid job spec", detail,
+                        Json{{"errors", errors}});
   }
 
   NewJob job;
@@ -464,9 +486,9 @@ void Service::Impl::post_job(const Request& req, Response& res, const httplib::C
                           Json{{"jobID", submitted.job.id}});
     case SubmitOutcome::queue_full:
       res.set_header("Retry-After", "30");
-      return send_problem(res, 503, "queue-full", "Queue full",
-                          "the queue holds " + std::to_string(config.max_queue) +
-                              " jobs already; retry later");
+      return send_problem(
+          res, 503, "queue-full", "Queue full",
+          "the queue holds " + std::to_string(config.max_queue) + " jobs already; retry later");
   }
 }
 
@@ -480,10 +502,11 @@ void Service::Impl::list_jobs(const Request& req, Response& res) {
       const std::string value = values.substr(start, comma - start);
       const auto status = parse_status(value);
       if (!status) {
-        return send_problem(res, 400, "invalid-parameter", "Invalid parameter",
-                            "status must be accepted, running, successful, failed or dismissed",
-                            Json{{"errors", Json::array({Json{{"path", "status"},
-                                                              {"message", "unknown status '" + value + "'"}}})}});
+        return send_problem(
+            res, 400, "invalid-parameter", "Invalid parameter",
+            "status must be accepted, running, successful, failed or dismissed",
+            Json{{"errors", Json::array({Json{{"path", "status"},
+                                              {"message", "unknown status '" + value + "'"}}})}});
       }
       statuses.push_back(*status);
       start = comma + 1;
@@ -494,10 +517,10 @@ void Service::Impl::list_jobs(const Request& req, Response& res) {
     const std::string v = req.get_param_value("limit");
     const auto [end, ec] = std::from_chars(v.data(), v.data() + v.size(), limit);
     if (ec != std::errc() || end != v.data() + v.size() || limit < 1 || limit > 1000) {
-      return send_problem(res, 400, "invalid-parameter", "Invalid parameter",
-                          "limit must be an integer from 1 to 1000",
-                          Json{{"errors", Json::array({Json{{"path", "limit"},
-                                                            {"message", "must be 1..1000"}}})}});
+      return send_problem(
+          res, 400, "invalid-parameter", "Invalid parameter",
+          "limit must be an integer from 1 to 1000",
+          Json{{"errors", Json::array({Json{{"path", "limit"}, {"message", "must be 1..1000"}}})}});
     }
   }
   Json jobs = Json::array();
@@ -526,7 +549,9 @@ void Service::Impl::dismiss_job(const Request& req, Response& res) {
     std::filesystem::remove_all(workers.job_dir(id), ec);
   }
   if (before->status != JobStatus::dismissed) {
-    log_line({{"event", "job"}, {"job", id}, {"status", "dismissed"},
+    log_line({{"event", "job"},
+              {"job", id},
+              {"status", "dismissed"},
               {"from", status_name(before->status)}});
   }
   const auto after = store.find(id);
@@ -549,7 +574,8 @@ std::optional<JobRecord> Service::Impl::finished_job(const std::string& id, Resp
     send_problem(res, 404, "result-not-ready", "Result not ready",
                  std::string("the job is ") + status_name(job->status) +
                      "; its results appear when it has finished",
-                 Json{{"jobID", id}, {"jobStatus", status_name(job->status)},
+                 Json{{"jobID", id},
+                      {"jobStatus", status_name(job->status)},
                       {"progress", whole_percent(job->progress)}});
     return std::nullopt;
   }
@@ -567,7 +593,8 @@ void Service::Impl::get_manifest(const Request& req, Response& res) {
                          {"sha256", f.sha256},
                          {"href", "/jobs/" + job->id + "/results/" + f.name}});
   }
-  send_json(res, 200, Json{{"jobID", job->id}, {"status", status_name(job->status)}, {"files", files}});
+  send_json(res, 200,
+            Json{{"jobID", job->id}, {"status", status_name(job->status)}, {"files", files}});
 }
 
 void Service::Impl::get_result_file(const Request& req, Response& res) {
@@ -580,13 +607,16 @@ void Service::Impl::get_result_file(const Request& req, Response& res) {
   for (ResultFile& f : store.results(job->id)) {
     if (f.name == name) file = std::move(f);
   }
-  if (!file) return send_not_found(res, "job " + job->id + " has no result file named '" + name + "'");
+  if (!file)
+    return send_not_found(res, "job " + job->id + " has no result file named '" + name + "'");
   const auto path = workers.job_dir(job->id) / file->name;
   std::error_code ec;
   const auto size = std::filesystem::file_size(path, ec);
   auto in = std::make_shared<std::ifstream>(path, std::ios::binary);
   if (ec || !*in || static_cast<std::int64_t>(size) != file->size) {
-    log_line({{"event", "error"}, {"job", job->id}, {"detail", "result file missing or changed: " + file->name}});
+    log_line({{"event", "error"},
+              {"job", job->id},
+              {"detail", "result file missing or changed: " + file->name}});
     return send_problem(res, 500, "result-missing", "Result file missing",
                         "the result file is missing or was changed on the server");
   }
@@ -597,16 +627,16 @@ void Service::Impl::get_result_file(const Request& req, Response& res) {
     return;
   }
   res.set_header("Content-Disposition", "attachment; filename=\"" + file->name + "\"");
-  res.set_content_provider(size, file->media_type,
-                           [in](std::size_t offset, std::size_t length, httplib::DataSink& sink) {
-                             std::array<char, 1 << 16> buffer{};
-                             in->seekg(static_cast<std::streamoff>(offset));
-                             in->read(buffer.data(), static_cast<std::streamsize>(
-                                                         std::min(length, buffer.size())));
-                             const auto n = in->gcount();
-                             if (n <= 0) return false;
-                             return sink.write(buffer.data(), static_cast<std::size_t>(n));
-                           });
+  res.set_content_provider(
+      size, file->media_type,
+      [in](std::size_t offset, std::size_t length, httplib::DataSink& sink) {
+        std::array<char, 1 << 16> buffer{};
+        in->seekg(static_cast<std::streamoff>(offset));
+        in->read(buffer.data(), static_cast<std::streamsize>(std::min(length, buffer.size())));
+        const auto n = in->gcount();
+        if (n <= 0) return false;
+        return sink.write(buffer.data(), static_cast<std::size_t>(n));
+      });
 }
 
 void Service::Impl::stream_events(const Request& req, Response& res) {
@@ -651,9 +681,9 @@ void Service::Impl::stream_events(const Request& req, Response& res) {
           if (status != state->last_status || progress != state->last_progress) {
             state->last_status = status;
             state->last_progress = progress;
-            out += "id: " + std::to_string(++state->sent) + "\nevent: " +
-                   (is_terminal(job->status) ? "done" : "progress") +
-                   "\ndata: " + status_document(*job).dump(-1, ' ', false, Json::error_handler_t::replace) +
+            out += "id: " + std::to_string(++state->sent) +
+                   "\nevent: " + (is_terminal(job->status) ? "done" : "progress") + "\ndata: " +
+                   status_document(*job).dump(-1, ' ', false, Json::error_handler_t::replace) +
                    "\n\n";
           } else if (SteadyClock::now() - state->last_write >=
                      std::chrono::duration<double>(config.heartbeat_interval_s)) {
@@ -704,9 +734,13 @@ bool Service::run() {
   if (s.port < 0) return false;
   s.run_started = true;
   s.workers.start();
-  log_line({{"event", "start"}, {"host", s.config.host}, {"port", s.port},
-            {"workers", s.config.workers}, {"threads_per_job", s.config.threads_per_job},
-            {"db", s.config.db_path.string()}, {"data_dir", s.config.data_dir.string()},
+  log_line({{"event", "start"},
+            {"host", s.config.host},
+            {"port", s.port},
+            {"workers", s.config.workers},
+            {"threads_per_job", s.config.threads_per_job},
+            {"db", s.config.db_path.string()},
+            {"data_dir", s.config.data_dir.string()},
             {"auth", !s.config.token.empty()}});
   const bool ok = s.stopping || s.http.listen_after_bind();
   s.workers.shutdown();  // running jobs go back to the queue
@@ -727,8 +761,12 @@ void Service::stop() {
   s.http.stop();
 }
 
-bool Service::is_running() const { return impl_->http.is_running(); }
+bool Service::is_running() const {
+  return impl_->http.is_running();
+}
 
-const ServiceConfig& Service::config() const { return impl_->config; }
+const ServiceConfig& Service::config() const {
+  return impl_->config;
+}
 
 }  // namespace hmpm::server

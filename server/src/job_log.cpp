@@ -13,7 +13,9 @@ std::mutex log_mutex;
 std::atomic<bool> logging_enabled{true};
 }  // namespace
 
-void set_logging_enabled(bool enabled) { logging_enabled = enabled; }
+void set_logging_enabled(bool enabled) {
+  logging_enabled = enabled;
+}
 
 void log_line(nlohmann::ordered_json fields) {
   if (!logging_enabled) return;

@@ -26,8 +26,8 @@ std::string Metrics::render(const StatusCounts& counts, int workers) const {
   for (JobStatus s : {JobStatus::accepted, JobStatus::running, JobStatus::successful,
                       JobStatus::failed, JobStatus::dismissed}) {
     const auto it = counts.find(s);
-    out << "hmpm_jobs{status=\"" << status_name(s) << "\"} " << (it == counts.end() ? 0 : it->second)
-        << "\n";
+    out << "hmpm_jobs{status=\"" << status_name(s) << "\"} "
+        << (it == counts.end() ? 0 : it->second) << "\n";
   }
   const auto queued = counts.find(JobStatus::accepted);
   out << "# HELP hmpm_queue_length Jobs waiting for a worker.\n# TYPE hmpm_queue_length gauge\n"

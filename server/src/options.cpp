@@ -12,7 +12,8 @@ namespace {
 bool parse_int(const std::string& text, long lo, long hi, long& out) {
   long value = 0;
   const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
-  if (ec != std::errc() || end != text.data() + text.size() || value < lo || value > hi) return false;
+  if (ec != std::errc() || end != text.data() + text.size() || value < lo || value > hi)
+    return false;
   out = value;
   return true;
 }
@@ -70,26 +71,45 @@ ParsedOptions parse_options(const std::vector<std::string>& args, const char* en
   };
   // Each flag takes one value; the handler returns "" or what is wrong.
   const std::map<std::string, std::function<std::string(const std::string&)>> flags{
-      {"--host", [&](const std::string& v) { config.host = v; return std::string(); }},
+      {"--host",
+       [&](const std::string& v) {
+         config.host = v;
+         return std::string();
+       }},
       {"--port", integer(0, 65535, [&](long n) { config.port = static_cast<int>(n); })},
-      {"--db", [&](const std::string& v) { config.db_path = v; return std::string(); }},
-      {"--data-dir", [&](const std::string& v) { config.data_dir = v; return std::string(); }},
+      {"--db",
+       [&](const std::string& v) {
+         config.db_path = v;
+         return std::string();
+       }},
+      {"--data-dir",
+       [&](const std::string& v) {
+         config.data_dir = v;
+         return std::string();
+       }},
       {"--workers", integer(1, 1024, [&](long n) { config.workers = static_cast<int>(n); })},
       {"--threads-per-job",
        integer(1, 4096, [&](long n) { config.threads_per_job = static_cast<int>(n); })},
-      {"--token", [&](const std::string& v) { config.token = v; return std::string(); }},
+      {"--token",
+       [&](const std::string& v) {
+         config.token = v;
+         return std::string();
+       }},
       {"--max-queue", integer(0, 100'000'000, [&](long n) { config.max_queue = n; })},
       {"--job-wall-time",
        [&](const std::string& v) {
          return parse_seconds(v, config.job_wall_time_s) ? std::string()
                                                          : std::string("must be seconds >= 0");
        }},
-      {"--max-attempts", integer(1, 1000, [&](long n) { config.max_attempts = static_cast<int>(n); })},
+      {"--max-attempts",
+       integer(1, 1000, [&](long n) { config.max_attempts = static_cast<int>(n); })},
       {"--max-body-bytes",
-       integer(1024, long{1} << 40, [&](long n) { config.max_body_bytes = static_cast<std::size_t>(n); })},
+       integer(1024, long{1} << 40,
+               [&](long n) { config.max_body_bytes = static_cast<std::size_t>(n); })},
       {"--max-event-streams",
        integer(0, 1000, [&](long n) { config.max_event_streams = static_cast<int>(n); })},
-      {"--http-threads", integer(2, 1024, [&](long n) { config.http_threads = static_cast<int>(n); })},
+      {"--http-threads",
+       integer(2, 1024, [&](long n) { config.http_threads = static_cast<int>(n); })},
   };
 
   for (std::size_t i = 0; i < args.size(); ++i) {

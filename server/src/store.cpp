@@ -193,7 +193,9 @@ std::optional<JobRecord> select_job(sqlite3* db, std::string_view where, std::st
 
 }  // namespace
 
-const char* status_name(JobStatus status) { return status_names[static_cast<std::size_t>(status)]; }
+const char* status_name(JobStatus status) {
+  return status_names[static_cast<std::size_t>(status)];
+}
 
 std::optional<JobStatus> parse_status(std::string_view text) {
   for (std::size_t i = 0; i < status_names.size(); ++i) {
@@ -235,8 +237,8 @@ JobStore::JobStore(const std::filesystem::path& db_path) : path_(db_path) {
 }
 
 void JobStore::migrate() {
-  auto lease_ = lease();
-  sqlite3* db = lease_.get();
+  auto connection = lease();
+  sqlite3* db = connection.get();
   WriteTransaction tx(db);
   int version = 0;
   {
@@ -247,7 +249,8 @@ void JobStore::migrate() {
     throw StoreFailure("database schema version " + std::to_string(version) +
                        " is newer than this server's " + std::to_string(current_schema_version()));
   }
-  for (int v = version; v < current_schema_version(); ++v) exec(db, migrations[static_cast<std::size_t>(v)]);
+  for (int v = version; v < current_schema_version(); ++v)
+    exec(db, migrations[static_cast<std::size_t>(v)]);
   exec(db, ("PRAGMA user_version = " + std::to_string(current_schema_version())).c_str());
   tx.commit();
 }
@@ -258,14 +261,18 @@ void JobStore::close_idle() {
   idle_.clear();
 }
 
-JobStore::~JobStore() { close_idle(); }
-int JobStore::current_schema_version() { return static_cast<int>(migrations.size()); }
+JobStore::~JobStore() {
+  close_idle();
+}
+int JobStore::current_schema_version() {
+  return static_cast<int>(migrations.size());
+}
 
 sqlite3* JobStore::open_connection() {
   sqlite3* db = nullptr;
-  const int rc = sqlite3_open_v2(path_.c_str(), &db,
-                                 SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE | SQLITE_OPEN_NOMUTEX,
-                                 nullptr);
+  const int rc =
+      sqlite3_open_v2(path_.c_str(), &db,
+                      SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE | SQLITE_OPEN_NOMUTEX, nullptr);
   if (rc != SQLITE_OK) {
     const std::string message = db ? sqlite3_errmsg(db) : "out of memory";
     sqlite3_close(db);
@@ -307,8 +314,8 @@ int JobStore::schema_version() {
 }
 
 SubmitResult JobStore::submit(const NewJob& job, std::int64_t max_queue) {
-  auto lease_ = lease();
-  sqlite3* db = lease_.get();
+  auto connection = lease();
+  sqlite3* db = connection.get();
   WriteTransaction tx(db);
   if (!job.idempotency_key.empty()) {
     Statement s(db, "SELECT id, body_sha256 FROM jobs WHERE idempotency_key = ?1");
@@ -318,7 +325,8 @@ SubmitResult JobStore::submit(const NewJob& job, std::int64_t max_queue) {
       const bool same_body = s.text(1) == job.body_sha256;
       auto earlier = select_job(db, "id = ?1", earlier_id);
       tx.commit();
-      return {same_body ? SubmitOutcome::replayed : SubmitOutcome::key_conflict, std::move(*earlier)};
+      return {same_body ? SubmitOutcome::replayed : SubmitOutcome::key_conflict,
+              std::move(*earlier)};
     }
   }
   {
@@ -326,11 +334,12 @@ SubmitResult JobStore::submit(const NewJob& job, std::int64_t max_queue) {
     if (s.step() && s.integer(0) >= max_queue) return {SubmitOutcome::queue_full, {}};
   }
   const std::string now = now_rfc3339();
-  Statement s(db,
-              "INSERT INTO jobs (id, name, spec, status, message, created, updated, idempotency_key, "
-              "body_sha256, cost_particles, cost_nodes, cost_cells, cost_steps, cost_particle_steps, "
-              "cost_memory_bytes, cost_output_bytes, cost_dt) VALUES (?1, ?2, ?3, 'accepted', "
-              "'queued', ?4, ?4, ?5, ?6, ?7, ?8, ?9, ?10, ?11, ?12, ?13, ?14)");
+  Statement s(
+      db,
+      "INSERT INTO jobs (id, name, spec, status, message, created, updated, idempotency_key, "
+      "body_sha256, cost_particles, cost_nodes, cost_cells, cost_steps, cost_particle_steps, "
+      "cost_memory_bytes, cost_output_bytes, cost_dt) VALUES (?1, ?2, ?3, 'accepted', "
+      "'queued', ?4, ?4, ?5, ?6, ?7, ?8, ?9, ?10, ?11, ?12, ?13, ?14)");
   s.bind(1, job.id).bind(2, job.name).bind(3, job.spec).bind(4, now);
   s.bind_or_null(5, job.idempotency_key).bind_or_null(6, job.body_sha256);
   s.bind(7, job.cost.particles).bind(8, job.cost.nodes).bind(9, job.cost.cells);
@@ -366,8 +375,8 @@ std::vector<JobRecord> JobStore::list(const std::vector<JobStatus>& statuses, in
 }
 
 std::optional<JobRecord> JobStore::claim_next() {
-  auto lease_ = lease();
-  sqlite3* db = lease_.get();
+  auto connection = lease();
+  sqlite3* db = connection.get();
   WriteTransaction tx(db);
   std::string id;
   {
@@ -376,9 +385,10 @@ std::optional<JobRecord> JobStore::claim_next() {
     id = s.text(0);
   }
   const std::string now = now_rfc3339();
-  Statement s(db,
-              "UPDATE jobs SET status = 'running', progress = 0, message = 'running', started = ?1, "
-              "finished = NULL, updated = ?1, attempts = attempts + 1 WHERE id = ?2");
+  Statement s(
+      db,
+      "UPDATE jobs SET status = 'running', progress = 0, message = 'running', started = ?1, "
+      "finished = NULL, updated = ?1, attempts = attempts + 1 WHERE id = ?2");
   s.bind(1, now).bind(2, id);
   s.step();
   auto job = select_job(db, "id = ?1", id);
@@ -387,8 +397,8 @@ std::optional<JobRecord> JobStore::claim_next() {
 }
 
 bool JobStore::update_progress(const std::string& id, double percent) {
-  auto lease_ = lease();
-  sqlite3* db = lease_.get();
+  auto connection = lease();
+  sqlite3* db = connection.get();
   WriteTransaction tx(db);
   Statement s(db,
               "UPDATE jobs SET progress = ?1, updated = ?2 WHERE id = ?3 AND status = 'running'");
@@ -402,8 +412,8 @@ bool JobStore::update_progress(const std::string& id, double percent) {
 bool JobStore::finish(const std::string& id, JobStatus status, const std::string& message,
                       const std::string& failure_reason, const std::vector<ResultFile>& files,
                       double run_seconds) {
-  auto lease_ = lease();
-  sqlite3* db = lease_.get();
+  auto connection = lease();
+  sqlite3* db = connection.get();
   WriteTransaction tx(db);
   const std::string now = now_rfc3339();
   {
@@ -422,8 +432,9 @@ bool JobStore::finish(const std::string& id, JobStatus status, const std::string
     clear.step();
   }
   for (const ResultFile& f : files) {
-    Statement s(db,
-                "INSERT INTO results (job_id, name, size, sha256, media_type) VALUES (?1, ?2, ?3, ?4, ?5)");
+    Statement s(
+        db,
+        "INSERT INTO results (job_id, name, size, sha256, media_type) VALUES (?1, ?2, ?3, ?4, ?5)");
     s.bind(1, id).bind(2, f.name).bind(3, f.size).bind(4, f.sha256).bind(5, f.media_type);
     s.step();
   }
@@ -432,8 +443,8 @@ bool JobStore::finish(const std::string& id, JobStatus status, const std::string
 }
 
 bool JobStore::requeue(const std::string& id) {
-  auto lease_ = lease();
-  sqlite3* db = lease_.get();
+  auto connection = lease();
+  sqlite3* db = connection.get();
   WriteTransaction tx(db);
   Statement s(db,
               "UPDATE jobs SET status = 'accepted', progress = 0, started = NULL, "
@@ -447,8 +458,8 @@ bool JobStore::requeue(const std::string& id) {
 }
 
 std::optional<JobRecord> JobStore::dismiss(const std::string& id) {
-  auto lease_ = lease();
-  sqlite3* db = lease_.get();
+  auto connection = lease();
+  sqlite3* db = connection.get();
   WriteTransaction tx(db);
   auto before = select_job(db, "id = ?1", id);
   if (!before || before->status == JobStatus::dismissed) return before;
@@ -477,8 +488,8 @@ std::vector<ResultFile> JobStore::results(const std::string& id) {
 }
 
 RecoveryReport JobStore::recover(int max_attempts) {
-  auto lease_ = lease();
-  sqlite3* db = lease_.get();
+  auto connection = lease();
+  sqlite3* db = connection.get();
   WriteTransaction tx(db);
   std::vector<std::pair<std::string, int>> interrupted;
   {
@@ -489,9 +500,10 @@ RecoveryReport JobStore::recover(int max_attempts) {
   const std::string now = now_rfc3339();
   for (const auto& [id, attempts] : interrupted) {
     if (attempts < max_attempts) {
-      Statement s(db,
-                  "UPDATE jobs SET status = 'accepted', progress = 0, started = NULL, updated = ?1, "
-                  "message = 'queued again: the server stopped while it ran' WHERE id = ?2");
+      Statement s(
+          db,
+          "UPDATE jobs SET status = 'accepted', progress = 0, started = NULL, updated = ?1, "
+          "message = 'queued again: the server stopped while it ran' WHERE id = ?2");
       s.bind(1, now).bind(2, id);
       s.step();
       report.requeued.push_back(id);

@@ -38,7 +38,9 @@ std::string describe(const std::vector<hmpm::api::SpecError>& errors) {
 WorkerPool::WorkerPool(JobStore& store, Metrics& metrics, WorkerSettings settings)
     : store_(store), metrics_(metrics), settings_(std::move(settings)) {}
 
-WorkerPool::~WorkerPool() { shutdown(); }
+WorkerPool::~WorkerPool() {
+  shutdown();
+}
 
 std::filesystem::path WorkerPool::job_dir(const std::string& id) const {
   return settings_.data_dir / id;
@@ -151,7 +153,8 @@ void WorkerPool::run_one(const JobRecord& job, Running& running) {
     auto last_write = SteadyClock::now() - std::chrono::hours(1);
     options.on_progress = [&](const hmpm::Progress& p) {
       const auto now = SteadyClock::now();
-      if (now - last_write < std::chrono::duration<double>(0.5 * settings_.progress_interval_s)) return;
+      if (now - last_write < std::chrono::duration<double>(0.5 * settings_.progress_interval_s))
+        return;
       last_write = now;
       try {
         if (!store_.update_progress(job.id, std::clamp(100.0 * p.fraction, 0.0, 100.0))) {
@@ -168,9 +171,9 @@ void WorkerPool::run_one(const JobRecord& job, Running& running) {
       if (result.run.status == hmpm::RunStatus::successful) {
         outcome = JobStatus::successful;
       } else {
-        reason = result.run.message.empty() ? std::string("the run ended as ") +
-                                                  hmpm::status_name(result.run.status)
-                                            : result.run.message;
+        reason = result.run.message.empty()
+                     ? std::string("the run ended as ") + hmpm::status_name(result.run.status)
+                     : result.run.message;
       }
     } catch (const std::exception& e) {
       reason = std::string("could not write the result files: ") + e.what();

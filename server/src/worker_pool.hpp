@@ -31,8 +31,8 @@ namespace hmpm::server {
 struct WorkerSettings {
   int workers = 1;
   int threads_per_job = 1;
-  double wall_time_limit_s = 0.0;     ///< <= 0: none
-  double progress_interval_s = 1.0;   ///< how often progress reaches the store
+  double wall_time_limit_s = 0.0;    ///< <= 0: none
+  double progress_interval_s = 1.0;  ///< how often progress reaches the store
   std::filesystem::path data_dir;
   hmpm::api::Limits limits;
 };

@@ -35,8 +35,15 @@ class ServerProcess {
   ServerProcess(const std::filesystem::path& dir, std::vector<std::string> extra_args,
                 const std::string& env_token = "")
       : log_path_(dir / "server.log") {
-    std::vector<std::string> args{HMPM_SERVER_PATH, "--host", "127.0.0.1", "--port", "0", "--db",
-                                  (dir / "hmpm.sqlite").string(), "--threads-per-job", "1"};
+    std::vector<std::string> args{HMPM_SERVER_PATH,
+                                  "--host",
+                                  "127.0.0.1",
+                                  "--port",
+                                  "0",
+                                  "--db",
+                                  (dir / "hmpm.sqlite").string(),
+                                  "--threads-per-job",
+                                  "1"};
     args.insert(args.end(), extra_args.begin(), extra_args.end());
     int out[2];
     if (::pipe(out) != 0) return;
@@ -131,10 +138,12 @@ class ServiceTest : public ::testing::Test {
 
   void start(std::vector<std::string> args = {}, const std::string& env_token = "") {
     server_ = std::make_unique<ServerProcess>(dir_, std::move(args), env_token);
-    ASSERT_GT(server_->port(), 0) << "first stdout line: '" << server_->first_line() << "'\n" << server_->log();
+    ASSERT_GT(server_->port(), 0) << "first stdout line: '" << server_->first_line() << "'\n"
+                                  << server_->log();
   }
 
-  std::string submit(httplib::Client& client, const std::string& spec, const httplib::Headers& headers = {}) {
+  std::string submit(httplib::Client& client, const std::string& spec,
+                     const httplib::Headers& headers = {}) {
     auto res = client.Post("/jobs", headers, spec, "application/json");
     EXPECT_TRUE(res);
     if (!res) return "";
@@ -143,7 +152,9 @@ class ServiceTest : public ::testing::Test {
     return doc.is_object() ? doc.value("jobID", "") : "";
   }
 
-  static std::string status_of(const Json& doc) { return doc.is_object() ? doc.value("status", "") : ""; }
+  static std::string status_of(const Json& doc) {
+    return doc.is_object() ? doc.value("status", "") : "";
+  }
 
   std::filesystem::path dir_;
   std::unique_ptr<ServerProcess> server_;
@@ -164,7 +175,8 @@ int run_program(std::vector<std::string> args, double timeout_s) {
   const auto deadline = Clock::now() + std::chrono::duration<double>(timeout_s);
   while (Clock::now() < deadline) {
     int status = 0;
-    if (::waitpid(pid, &status, WNOHANG) == pid) return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    if (::waitpid(pid, &status, WNOHANG) == pid)
+      return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
   }
   ::kill(pid, SIGKILL);
@@ -174,7 +186,8 @@ int run_program(std::vector<std::string> args, double timeout_s) {
 
 TEST_F(ServiceTest, FirstLineAnnouncesTheAddress) {
   start();
-  EXPECT_EQ(server_->first_line(), "listening on http://127.0.0.1:" + std::to_string(server_->port()) + "\n");
+  EXPECT_EQ(server_->first_line(),
+            "listening on http://127.0.0.1:" + std::to_string(server_->port()) + "\n");
   auto client = server_->client();
   EXPECT_EQ(client.Get("/health")->status, 200);
 }
@@ -205,7 +218,10 @@ TEST_F(ServiceTest, SubmitPollAndResultsMatchTheCommandLine) {
   const auto spec_path = dir_ / "spec.json";
   std::ofstream(spec_path) << spec.dump();
   const auto out = dir_ / "cli-out";
-  ASSERT_EQ(run_program({HMPM_CLI_PATH, "run", spec_path.string(), "--out", out.string(), "--threads", "1"}, 60), 0);
+  ASSERT_EQ(
+      run_program(
+          {HMPM_CLI_PATH, "run", spec_path.string(), "--out", out.string(), "--threads", "1"}, 60),
+      0);
   EXPECT_TRUE(served_series->body == read_file(out / "series.json"))
       << "served series.json differs from `hmpm run`'s";
   const auto served_csv = client.Get(("/jobs/" + id + "/results/series.csv").c_str());
@@ -234,18 +250,21 @@ TEST_F(ServiceTest, HostileRequestsGet4xxProblemsAndTheServerKeepsAnswering) {
   };
   expect_4xx_problem(client.Post("/jobs", "not json at all", "application/json"), 400, "not JSON");
   expect_4xx_problem(client.Post("/jobs", "", "application/json"), 400, "empty");
-  expect_4xx_problem(client.Post("/jobs", std::string(100000, '[') + std::string(100000, ']'), "application/json"),
-                     400, "100 000 nested brackets");
-  expect_4xx_problem(client.Post("/jobs", std::string(64 << 20, ' '), "application/json"), 413, "64 MB body");
+  expect_4xx_problem(
+      client.Post("/jobs", std::string(100000, '[') + std::string(100000, ']'), "application/json"),
+      400, "100 000 nested brackets");
+  expect_4xx_problem(client.Post("/jobs", std::string(64 << 20, ' '), "application/json"), 413,
+                     "64 MB body");
   Json invalid = json_of(small_spec());
   invalid["dimension"] = 4;
   auto res = client.Post("/jobs", invalid.dump(), "application/json");
   expect_4xx_problem(res, 400, "invalid spec");
   EXPECT_FALSE(json_of(res->body)["errors"].empty());
   expect_4xx_problem(client.Get("/jobs/00000000-0000-4000-8000-000000000000"), 404, "unknown job");
-  expect_4xx_problem(client.Delete("/jobs/00000000-0000-4000-8000-000000000000"), 404, "unknown job delete");
-  expect_4xx_problem(client.Get(("/jobs/" + done_id + "/results/..%2F..%2Fhmpm.sqlite").c_str()), 404,
-                     "path traversal");
+  expect_4xx_problem(client.Delete("/jobs/00000000-0000-4000-8000-000000000000"), 404,
+                     "unknown job delete");
+  expect_4xx_problem(client.Get(("/jobs/" + done_id + "/results/..%2F..%2Fhmpm.sqlite").c_str()),
+                     404, "path traversal");
   const std::string raw = raw_http(server_->port(), "GARBAGE\r\n\r\n", 5);
   EXPECT_EQ(raw_status(raw), 400) << raw;
 
@@ -258,14 +277,17 @@ TEST_F(ServiceTest, CancelARunningJobAndTheWorkerTakesTheNext) {
   start({"--workers", "1"});
   auto client = server_->client();
   const std::string long_id = submit(client, long_spec("long", 10000));
-  ASSERT_EQ(status_of(poll_job(client, long_id, [](const Json& d) { return d.value("status", "") == "running"; }, 30)),
-            "running");
+  ASSERT_EQ(
+      status_of(poll_job(
+          client, long_id, [](const Json& d) { return d.value("status", "") == "running"; }, 30)),
+      "running");
   const std::string next_id = submit(client, small_spec("next"));
   auto res = client.Delete(("/jobs/" + long_id).c_str());
   ASSERT_TRUE(res);
   EXPECT_EQ(res->status, 200);
   EXPECT_EQ(json_of(res->body).value("status", ""), "dismissed");
-  const Json next = poll_job(client, next_id, [](const Json& d) { return d.value("status", "") != "accepted"; }, 1.0);
+  const Json next = poll_job(
+      client, next_id, [](const Json& d) { return d.value("status", "") != "accepted"; }, 1.0);
   EXPECT_NE(status_of(next), "accepted") << "the worker did not take the next job within 1 s";
   EXPECT_EQ(status_of(poll_job(client, next_id, is_final, 60)), "successful");
   EXPECT_EQ(status_of(poll_job(client, long_id, is_final, 1)), "dismissed");
@@ -278,9 +300,12 @@ TEST_F(ServiceTest, KillNineThenRestartEndsEveryJob) {
   {
     auto client = server_->client();
     ids.push_back(submit(client, long_spec("running-when-killed", 100)));
-    for (int i = 0; i < 3; ++i) ids.push_back(submit(client, small_spec("queued-" + std::to_string(i))));
-    ASSERT_EQ(status_of(poll_job(client, ids[0], [](const Json& d) { return d.value("status", "") == "running"; }, 30)),
-              "running");
+    for (int i = 0; i < 3; ++i)
+      ids.push_back(submit(client, small_spec("queued-" + std::to_string(i))));
+    ASSERT_EQ(
+        status_of(poll_job(
+            client, ids[0], [](const Json& d) { return d.value("status", "") == "running"; }, 30)),
+        "running");
   }
   EXPECT_EQ(server_->signal_and_wait(SIGKILL, 5), 128 + SIGKILL);
 
@@ -319,11 +344,13 @@ TEST_F(ServiceTest, EightClientsSubmitNinetySixJobsWhilePolling) {
         name += std::to_string(c * 100 + i);
         auto res = client.Post("/jobs", small_spec(name, 0.2), "application/json");
         if (!res || res->status != 201) {
-          note("submit: " + (res ? std::to_string(res->status) + " " + res->body : std::string("no answer")));
+          note("submit: " +
+               (res ? std::to_string(res->status) + " " + res->body : std::string("no answer")));
           continue;
         }
         mine.push_back(json_of(res->body).value("jobID", ""));
-        if (auto poll = client.Get(("/jobs/" + mine.front()).c_str()); !poll || poll->status != 200) {
+        if (auto poll = client.Get(("/jobs/" + mine.front()).c_str());
+            !poll || poll->status != 200) {
           note("poll while submitting failed");
         }
       }
@@ -336,9 +363,11 @@ TEST_F(ServiceTest, EightClientsSubmitNinetySixJobsWhilePolling) {
     });
   }
   for (auto& t : threads) t.join();
-  EXPECT_TRUE(problems.empty()) << problems.size() << " problems, first: " << (problems.empty() ? "" : problems[0]);
+  EXPECT_TRUE(problems.empty()) << problems.size()
+                                << " problems, first: " << (problems.empty() ? "" : problems[0]);
   EXPECT_EQ(ids.size(), static_cast<std::size_t>(clients * per_client));
-  EXPECT_EQ(std::set<std::string>(ids.begin(), ids.end()).size(), ids.size()) << "job ids are not distinct";
+  EXPECT_EQ(std::set<std::string>(ids.begin(), ids.end()).size(), ids.size())
+      << "job ids are not distinct";
   const std::string log = server_->log();
   EXPECT_EQ(log.find("database is locked"), std::string::npos);
   EXPECT_EQ(log.find("\"status\":500"), std::string::npos);
@@ -351,8 +380,8 @@ TEST_F(ServiceTest, EightClientsSubmitNinetySixJobsWhilePolling) {
     requests += entry.value("event", "") == "request";
     transitions += entry.value("event", "") == "job";
   }
-  EXPECT_GE(requests, 2u * clients * per_client);       // submits and polls
-  EXPECT_GE(transitions, 3u * clients * per_client);    // accepted, running, successful
+  EXPECT_GE(requests, 2u * clients * per_client);     // submits and polls
+  EXPECT_GE(transitions, 3u * clients * per_client);  // accepted, running, successful
 }
 
 TEST_F(ServiceTest, TokenFromTheEnvironmentGuardsAllButHealth) {
@@ -371,8 +400,10 @@ TEST_F(ServiceTest, SigtermExitsZeroAndTheRunningJobResumesAfterRestart) {
   {
     auto client = server_->client();
     id = submit(client, long_spec("resumed", 40));
-    ASSERT_EQ(status_of(poll_job(client, id, [](const Json& d) { return d.value("status", "") == "running"; }, 30)),
-              "running");
+    ASSERT_EQ(
+        status_of(poll_job(
+            client, id, [](const Json& d) { return d.value("status", "") == "running"; }, 30)),
+        "running");
   }
   EXPECT_EQ(server_->signal_and_wait(SIGTERM, 10), 0);
   start({"--workers", "1"});

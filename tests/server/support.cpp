@@ -17,24 +17,28 @@
 namespace hmpm::server::testing {
 
 std::string small_spec(const std::string& name, double end_s) {
-  Json spec = {
-      {"name", name},
-      {"dimension", 1},
-      {"grid", {{"min", {0.0}}, {"max", {1.0}}, {"cells", {13}}}},
-      {"materials",
-       {{"bar", {{"model", "linear_elastic"}, {"density", 1.0}, {"youngs_modulus", 10.0},
-                 {"poisson_ratio", 0.0}}}}},
-      {"bodies", Json::array({{{"material", "bar"},
-                               {"box", {{"min", {0.0}}, {"max", {1.0}}}},
-                               {"particles_per_cell", 1},
-                               {"initial", {{"velocity", {"0.1*sin(pi/2*x)"}}}}}})},
-      {"gravity", {0.0}},
-      {"boundaries",
-       Json::array({{{"nodes", {{"box", {{"min", {0.0}}, {"max", {0.0}}}}}}, {"velocity", {0.0}}}})},
-      {"time", {{"end", end_s}, {"dt", 1.0e-3}}},
-      {"output",
-       {{"series", {{"particles", {0, 3, 6, 12}}, {"fields", {"displacement", "velocity"}},
-                    {"interval", 0.01}}}}}};
+  Json spec = {{"name", name},
+               {"dimension", 1},
+               {"grid", {{"min", {0.0}}, {"max", {1.0}}, {"cells", {13}}}},
+               {"materials",
+                {{"bar",
+                  {{"model", "linear_elastic"},
+                   {"density", 1.0},
+                   {"youngs_modulus", 10.0},
+                   {"poisson_ratio", 0.0}}}}},
+               {"bodies", Json::array({{{"material", "bar"},
+                                        {"box", {{"min", {0.0}}, {"max", {1.0}}}},
+                                        {"particles_per_cell", 1},
+                                        {"initial", {{"velocity", {"0.1*sin(pi/2*x)"}}}}}})},
+               {"gravity", {0.0}},
+               {"boundaries", Json::array({{{"nodes", {{"box", {{"min", {0.0}}, {"max", {0.0}}}}}},
+                                            {"velocity", {0.0}}}})},
+               {"time", {{"end", end_s}, {"dt", 1.0e-3}}},
+               {"output",
+                {{"series",
+                  {{"particles", {0, 3, 6, 12}},
+                   {"fields", {"displacement", "velocity"}},
+                   {"interval", 0.01}}}}}};
   return spec.dump(2);
 }
 
@@ -44,7 +48,8 @@ std::string long_spec(const std::string& name, double end_s) {
   spec["bodies"][0]["box"] = {{"min", {0.0}}, {"max", {10.0}}};
   spec["bodies"][0]["particles_per_cell"] = 2;
   spec["bodies"][0]["initial"] = {{"velocity", {"0.01*sin(pi/20*x)"}}};
-  spec["output"] = {{"series", {{"particles", {0, 999}}, {"fields", {"displacement"}}, {"interval", 1.0}}}};
+  spec["output"] = {
+      {"series", {{"particles", {0, 999}}, {"fields", {"displacement"}}, {"interval", 1.0}}}};
   return spec.dump(2);
 }
 
@@ -74,7 +79,8 @@ std::string raw_http(int port, const std::string& request, double timeout_s) {
       if (n <= 0) break;  // the server may answer and close before reading it all
       sent += static_cast<std::size_t>(n);
     }
-    const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
+    const auto deadline =
+        std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
     char buffer[8192];
     while (std::chrono::steady_clock::now() < deadline) {
       pollfd p{fd, POLLIN, 0};
@@ -104,7 +110,9 @@ bool is_final(const Json& doc) {
   return s == "successful" || s == "failed" || s == "dismissed";
 }
 
-Json json_of(const std::string& body) { return Json::parse(body, nullptr, false); }
+Json json_of(const std::string& body) {
+  return Json::parse(body, nullptr, false);
+}
 
 Json poll_job(httplib::Client& client, const std::string& id,
               const std::function<bool(const Json&)>& done, double timeout_s,

@@ -19,12 +19,20 @@ TEST(Options, DefaultsNeedOnlyTheDatabase) {
 }
 
 TEST(Options, EveryFlagIsRead) {
-  const auto parsed = parse_options(
-      {"--host", "0.0.0.0", "--port=0", "--db", "d.sqlite", "--workers", "3", "--data-dir", "res",
-       "--threads-per-job", "2", "--token", "t", "--max-queue", "5", "--job-wall-time", "1.5",
-       "--max-attempts", "4", "--max-body-bytes", "4096", "--max-event-streams", "2",
-       "--http-threads", "6"},
-      "env-token");
+  const auto parsed = parse_options({"--host",   "0.0.0.0",
+                                     "--port=0", "--db",
+                                     "d.sqlite", "--workers",
+                                     "3",        "--data-dir",
+                                     "res",      "--threads-per-job",
+                                     "2",        "--token",
+                                     "t",        "--max-queue",
+                                     "5",        "--job-wall-time",
+                                     "1.5",      "--max-attempts",
+                                     "4",        "--max-body-bytes",
+                                     "4096",     "--max-event-streams",
+                                     "2",        "--http-threads",
+                                     "6"},
+                                    "env-token");
   ASSERT_TRUE(parsed.config) << parsed.error;
   const ServiceConfig& c = *parsed.config;
   EXPECT_EQ(c.host, "0.0.0.0");
@@ -49,11 +57,16 @@ TEST(Options, TokenComesFromTheEnvironment) {
 
 TEST(Options, MistakesAreReportedNotFatal) {
   EXPECT_NE(parse_options({}, nullptr).error.find("--db"), std::string::npos);
-  EXPECT_NE(parse_options({"--db", "d", "--port", "70000"}, nullptr).error.find("--port"), std::string::npos);
-  EXPECT_NE(parse_options({"--db", "d", "--workers", "two"}, nullptr).error.find("--workers"), std::string::npos);
-  EXPECT_NE(parse_options({"--db", "d", "--workers", "0"}, nullptr).error.find("--workers"), std::string::npos);
-  EXPECT_NE(parse_options({"--db", "d", "--job-wall-time", "-1"}, nullptr).error.find("seconds"), std::string::npos);
-  EXPECT_NE(parse_options({"--db", "d", "--bogus", "1"}, nullptr).error.find("unknown option"), std::string::npos);
+  EXPECT_NE(parse_options({"--db", "d", "--port", "70000"}, nullptr).error.find("--port"),
+            std::string::npos);
+  EXPECT_NE(parse_options({"--db", "d", "--workers", "two"}, nullptr).error.find("--workers"),
+            std::string::npos);
+  EXPECT_NE(parse_options({"--db", "d", "--workers", "0"}, nullptr).error.find("--workers"),
+            std::string::npos);
+  EXPECT_NE(parse_options({"--db", "d", "--job-wall-time", "-1"}, nullptr).error.find("seconds"),
+            std::string::npos);
+  EXPECT_NE(parse_options({"--db", "d", "--bogus", "1"}, nullptr).error.find("unknown option"),
+            std::string::npos);
   EXPECT_NE(parse_options({"--db"}, nullptr).error.find("needs a value"), std::string::npos);
   EXPECT_TRUE(parse_options({"--help"}, nullptr).help);
 }

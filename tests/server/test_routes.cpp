@@ -79,8 +79,8 @@ class RoutesTest : public ::testing::Test {
   }
 
   Json wait_until(const std::string& id, const std::string& status, double timeout_s = 60) {
-    return poll_job(*client_, id, [&](const Json& d) { return d.value("status", "") == status; },
-                    timeout_s);
+    return poll_job(
+        *client_, id, [&](const Json& d) { return d.value("status", "") == status; }, timeout_s);
   }
 
   Json wait_final(const std::string& id, double timeout_s = 60) {
@@ -171,11 +171,12 @@ TEST_F(RoutesTest, SubmitPollAndDownloadResults) {
 
 TEST_F(RoutesTest, HostileBodiesGetProblemDocumentsAndTheServerKeepsAnswering) {
   start();
-  const std::vector<std::string> bodies{"this is not JSON", "",
-                                        std::string(100000, '[') + std::string(100000, ']'),
-                                        std::string(100000, '{'), std::string("\xff\xfe\x00\x01", 4)};
+  const std::vector<std::string> bodies{
+      "this is not JSON", "", std::string(100000, '[') + std::string(100000, ']'),
+      std::string(100000, '{'), std::string("\xff\xfe\x00\x01", 4)};
   for (const std::string& body : bodies) {
-    const Json doc = expect_problem(client_->Post("/jobs", body, "application/json"), 400, "invalid-spec");
+    const Json doc =
+        expect_problem(client_->Post("/jobs", body, "application/json"), 400, "invalid-spec");
     ASSERT_TRUE(doc.contains("errors"));
     ASSERT_FALSE(doc["errors"].empty());
     EXPECT_TRUE(doc["errors"][0].contains("path"));
@@ -184,7 +185,8 @@ TEST_F(RoutesTest, HostileBodiesGetProblemDocumentsAndTheServerKeepsAnswering) {
   Json spec = json_of(small_spec());
   spec["materials"]["bar"]["youngs_modulus"] = -1.0;
   spec["time"].erase("end");
-  const Json doc = expect_problem(client_->Post("/jobs", spec.dump(), "application/json"), 400, "invalid-spec");
+  const Json doc =
+      expect_problem(client_->Post("/jobs", spec.dump(), "application/json"), 400, "invalid-spec");
   std::set<std::string> paths;
   for (const Json& e : doc["errors"]) paths.insert(e["path"].get<std::string>());
   EXPECT_TRUE(paths.count("/materials/bar/youngs_modulus")) << doc.dump();
@@ -206,20 +208,23 @@ TEST_F(RoutesTest, BodiesWithoutLengthOrOverTheLimitAreRefused) {
   ServiceConfig c = config();
   c.max_body_bytes = 64 * 1024;
   start(c);
-  std::string res = raw_http(port_, "POST /jobs HTTP/1.1\r\nHost: x\r\nConnection: close\r\n\r\n{}");
+  std::string res =
+      raw_http(port_, "POST /jobs HTTP/1.1\r\nHost: x\r\nConnection: close\r\n\r\n{}");
   EXPECT_EQ(raw_status(res), 411) << res;
   EXPECT_EQ(json_of(raw_body(res)).value("type", ""), "length-required");
   res = raw_http(port_,
                  "POST /jobs HTTP/1.1\r\nHost: x\r\nTransfer-Encoding: chunked\r\nConnection: "
                  "close\r\n\r\n2\r\n{}\r\n0\r\n\r\n");
   EXPECT_EQ(raw_status(res), 411) << res;
-  res = raw_http(port_, "POST /jobs HTTP/1.1\r\nHost: x\r\nContent-Length: abc\r\nConnection: close\r\n\r\n");
+  res = raw_http(
+      port_, "POST /jobs HTTP/1.1\r\nHost: x\r\nContent-Length: abc\r\nConnection: close\r\n\r\n");
   EXPECT_EQ(raw_status(res), 400) << res;
 
   const std::string big(200 * 1024, ' ');
   expect_problem(client_->Post("/jobs", big, "application/json"), 413, "payload-too-large");
-  res = raw_http(port_, "POST /jobs HTTP/1.1\r\nHost: x\r\nContent-Length: " + std::to_string(big.size()) +
-                            "\r\nExpect: 100-continue\r\nConnection: close\r\n\r\n");
+  res = raw_http(port_,
+                 "POST /jobs HTTP/1.1\r\nHost: x\r\nContent-Length: " + std::to_string(big.size()) +
+                     "\r\nExpect: 100-continue\r\nConnection: close\r\n\r\n");
   EXPECT_EQ(raw_status(res), 413) << res;  // refused before the body is sent
   EXPECT_EQ(client_->Get("/health")->status, 200);
 }
@@ -236,7 +241,8 @@ TEST_F(RoutesTest, TokenGuardsEverythingButHealth) {
   expect_problem(client_->Get("/jobs", {{"Authorization", "Bearer s3cre"}}), 401, "unauthorized");
   expect_problem(client_->Get("/metrics"), 401, "unauthorized");
   expect_problem(client_->Post("/jobs", small_spec(), "application/json"), 401, "unauthorized");
-  expect_problem(client_->Delete("/jobs/00000000-0000-4000-8000-000000000000"), 401, "unauthorized");
+  expect_problem(client_->Delete("/jobs/00000000-0000-4000-8000-000000000000"), 401,
+                 "unauthorized");
   res = client_->Get("/jobs", {{"Authorization", "bearer s3cret"}});
   ASSERT_TRUE(res);
   EXPECT_EQ(res->status, 200);
@@ -256,7 +262,8 @@ TEST_F(RoutesTest, ResultNamesOutsideTheManifestAreRefused) {
     expect_problem(client_->Get((base + name).c_str()), 404, "not-found");
   }
   const std::string res = raw_http(
-      port_, "GET " + base + "../../../db/hmpm.sqlite HTTP/1.1\r\nHost: x\r\nConnection: close\r\n\r\n");
+      port_,
+      "GET " + base + "../../../db/hmpm.sqlite HTTP/1.1\r\nHost: x\r\nConnection: close\r\n\r\n");
   EXPECT_EQ(raw_status(res), 404) << res;
   EXPECT_EQ(client_->Get((base + "summary.json").c_str())->status, 200);
 }
@@ -275,9 +282,11 @@ TEST_F(RoutesTest, CancelDismissesTheRunningJobWithinASecondAndTheWorkerTakesThe
   ASSERT_EQ(res->status, 200) << res->body;
   EXPECT_EQ(json_of(res->body)["status"], "dismissed");
   // The worker is free again within a second: it has started the next job.
-  const Json next = poll_job(*client_, next_id, [](const Json& d) { return d.value("status", "") != "accepted"; }, 1.0);
-  EXPECT_NE(next.value("status", ""), "accepted") << "worker still busy after "
-                                                  << std::chrono::duration<double>(Clock::now() - t0).count() << " s";
+  const Json next = poll_job(
+      *client_, next_id, [](const Json& d) { return d.value("status", "") != "accepted"; }, 1.0);
+  EXPECT_NE(next.value("status", ""), "accepted")
+      << "worker still busy after " << std::chrono::duration<double>(Clock::now() - t0).count()
+      << " s";
   EXPECT_EQ(wait_final(next_id).value("status", ""), "successful");
   EXPECT_EQ(json_of(client_->Get(("/jobs/" + long_id).c_str())->body)["status"], "dismissed");
   expect_problem(client_->Get(("/jobs/" + long_id + "/results").c_str()), 410, "job-dismissed");
@@ -297,8 +306,9 @@ TEST_F(RoutesTest, IdempotencyKeyReturnsTheOriginalJob) {
   EXPECT_EQ(res->status, 201);
   EXPECT_EQ(json_of(res->body)["jobID"], id);
   EXPECT_EQ(res->get_header_value("Idempotent-Replayed"), "true");
-  const Json conflict = expect_problem(client_->Post("/jobs", key, small_spec("twice"), "application/json"),
-                                       422, "idempotency-key-reused");
+  const Json conflict =
+      expect_problem(client_->Post("/jobs", key, small_spec("twice"), "application/json"), 422,
+                     "idempotency-key-reused");
   EXPECT_EQ(conflict.value("jobID", ""), id);
   EXPECT_EQ(json_of(client_->Get("/jobs")->body)["jobs"].size(), 1u);
 }
@@ -320,17 +330,19 @@ TEST_F(RoutesTest, EventsStreamProgressAndTheFinalState) {
   start();
   const std::string id = submit(long_spec("streamed", 20));
   std::string stream;
-  auto res = client_->Get(("/jobs/" + id + "/events").c_str(), [&](const char* data, std::size_t n) {
-    stream.append(data, n);
-    return stream.size() < (1 << 20);
-  });
+  auto res =
+      client_->Get(("/jobs/" + id + "/events").c_str(), [&](const char* data, std::size_t n) {
+        stream.append(data, n);
+        return stream.size() < (1 << 20);
+      });
   ASSERT_TRUE(res);
   EXPECT_EQ(res->status, 200);
   EXPECT_EQ(res->get_header_value("Content-Type"), "text/event-stream");
   EXPECT_NE(stream.find("event: progress\n"), std::string::npos) << stream.substr(0, 500);
   const auto done = stream.find("event: done\ndata: ");
   ASSERT_NE(done, std::string::npos) << stream.substr(0, 2000);
-  const Json final_doc = json_of(stream.substr(done + 18, stream.find('\n', done + 18) - done - 18));
+  const Json final_doc =
+      json_of(stream.substr(done + 18, stream.find('\n', done + 18) - done - 18));
   EXPECT_EQ(final_doc.value("status", ""), "successful");
   EXPECT_EQ(final_doc.value("jobID", ""), id);
 }
@@ -343,7 +355,8 @@ TEST_F(RoutesTest, EventStreamsAreCapped) {
   auto res = client_->Get(("/jobs/" + id + "/events").c_str());
   expect_problem(res, 503, "too-many-streams");
   EXPECT_FALSE(res->get_header_value("Retry-After").empty());
-  expect_problem(client_->Get("/jobs/00000000-0000-4000-8000-000000000000/events"), 404, "not-found");
+  expect_problem(client_->Get("/jobs/00000000-0000-4000-8000-000000000000/events"), 404,
+                 "not-found");
 }
 
 TEST_F(RoutesTest, EventStreamsSendHeartbeatsWhenNothingChanges) {
@@ -354,7 +367,8 @@ TEST_F(RoutesTest, EventStreamsSendHeartbeatsWhenNothingChanges) {
   const auto t0 = Clock::now();
   client_->Get(("/jobs/" + id + "/events").c_str(), [&](const char* data, std::size_t n) {
     stream.append(data, n);
-    return stream.find(": heartbeat\n") == std::string::npos && Clock::now() - t0 < std::chrono::seconds(10);
+    return stream.find(": heartbeat\n") == std::string::npos &&
+           Clock::now() - t0 < std::chrono::seconds(10);
   });
   EXPECT_NE(stream.find(": heartbeat\n"), std::string::npos) << stream.substr(0, 1000);
   EXPECT_NE(stream.find("\"status\":\"accepted\""), std::string::npos) << stream.substr(0, 1000);
@@ -387,7 +401,8 @@ TEST_F(RoutesTest, ListFiltersAndMetricsCount) {
   ASSERT_GE(list["jobs"].size(), 1u);
   for (const Json& j : list["jobs"]) EXPECT_EQ(j["status"], "successful");
   EXPECT_EQ(json_of(client_->Get("/jobs?limit=1")->body)["jobs"].size(), 1u);
-  EXPECT_EQ(json_of(client_->Get("/jobs?status=accepted,running,successful")->body)["jobs"].size(), 2u);
+  EXPECT_EQ(json_of(client_->Get("/jobs?status=accepted,running,successful")->body)["jobs"].size(),
+            2u);
 
   res = client_->Get("/metrics");
   ASSERT_TRUE(res);
@@ -395,7 +410,8 @@ TEST_F(RoutesTest, ListFiltersAndMetricsCount) {
   EXPECT_NE(res->body.find("hmpm_jobs{status=\"successful\"} "), std::string::npos) << res->body;
   EXPECT_NE(res->body.find("hmpm_queue_length "), std::string::npos);
   EXPECT_NE(res->body.find("hmpm_job_duration_seconds_count "), std::string::npos);
-  EXPECT_NE(res->body.find("hmpm_http_requests_total{code=\"201\"} 2"), std::string::npos) << res->body;
+  EXPECT_NE(res->body.find("hmpm_http_requests_total{code=\"201\"} 2"), std::string::npos)
+      << res->body;
 }
 
 TEST_F(RoutesTest, StopRequeuesTheRunningJobAndTheNextStartFinishesIt) {

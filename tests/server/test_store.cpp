@@ -43,7 +43,8 @@ class StoreTest : public ::testing::Test {
     sqlite3_exec(
         db, sql.c_str(),
         [](void* o, int n, char** values, char**) {
-          for (int i = 0; i < n; ++i) *static_cast<std::string*>(o) += (values[i] ? values[i] : "NULL") + std::string(";");
+          for (int i = 0; i < n; ++i)
+            *static_cast<std::string*>(o) += (values[i] ? values[i] : "NULL") + std::string(";");
           return 0;
         },
         &out, nullptr);
@@ -59,7 +60,8 @@ TEST_F(StoreTest, FreshDatabaseIsMigratedToTheCurrentSchemaInWalMode) {
   EXPECT_EQ(store.schema_version(), JobStore::current_schema_version());
   EXPECT_EQ(query("PRAGMA user_version"), std::to_string(JobStore::current_schema_version()) + ";");
   EXPECT_EQ(query("PRAGMA journal_mode"), "wal;");
-  EXPECT_EQ(query("SELECT name FROM sqlite_master WHERE type = 'table' AND name IN ('jobs','results') ORDER BY name"),
+  EXPECT_EQ(query("SELECT name FROM sqlite_master WHERE type = 'table' AND name IN "
+                  "('jobs','results') ORDER BY name"),
             "jobs;results;");
 }
 
@@ -112,7 +114,8 @@ TEST_F(StoreTest, ProgressAndFinishApplyOnlyToRunningJobs) {
   store.claim_next();
   EXPECT_TRUE(store.update_progress(id, 42.5));
   EXPECT_DOUBLE_EQ(store.find(id)->progress, 42.5);
-  const std::vector<ResultFile> files{{"summary.json", 12, std::string(64, 'a'), "application/json"}};
+  const std::vector<ResultFile> files{
+      {"summary.json", 12, std::string(64, 'a'), "application/json"}};
   EXPECT_TRUE(store.finish(id, JobStatus::successful, "finished", "", files, 1.5));
   const auto done = store.find(id);
   EXPECT_EQ(done->status, JobStatus::successful);
