@@ -12,8 +12,8 @@ void Metrics::count_request(int status) {
 
 void Metrics::observe_job(double seconds, JobStatus outcome) {
   std::lock_guard<std::mutex> lock(mutex_);
-  for (std::size_t i = 0; i < bucket_bounds_.size(); ++i) {
-    if (seconds <= bucket_bounds_[i]) ++duration_buckets_[i];
+  for (std::size_t i = 0; i < bucket_bounds.size(); ++i) {
+    if (seconds <= bucket_bounds[i]) ++duration_buckets_[i];
   }
   ++duration_count_;
   duration_sum_ += seconds;
@@ -43,8 +43,8 @@ std::string Metrics::render(const StatusCounts& counts, int workers) const {
   std::lock_guard<std::mutex> lock(mutex_);
   out << "# HELP hmpm_job_duration_seconds Wall time of finished job attempts.\n"
          "# TYPE hmpm_job_duration_seconds histogram\n";
-  for (std::size_t i = 0; i < bucket_bounds_.size(); ++i) {
-    out << "hmpm_job_duration_seconds_bucket{le=\"" << bucket_bounds_[i] << "\"} "
+  for (std::size_t i = 0; i < bucket_bounds.size(); ++i) {
+    out << "hmpm_job_duration_seconds_bucket{le=\"" << bucket_bounds[i] << "\"} "
         << duration_buckets_[i] << "\n";
   }
   out << "hmpm_job_duration_seconds_bucket{le=\"+Inf\"} " << duration_count_ << "\n"

@@ -31,10 +31,10 @@ class Metrics {
   std::string render(const StatusCounts& counts, int workers) const;
 
  private:
-  static constexpr std::array<double, 10> bucket_bounds_{0.1, 0.5, 1, 2, 5, 10, 30, 60, 300, 3600};
+  static constexpr std::array<double, 10> bucket_bounds{0.1, 0.5, 1, 2, 5, 10, 30, 60, 300, 3600};
   mutable std::mutex mutex_;
   std::map<int, std::uint64_t> requests_by_status_;
-  std::array<std::uint64_t, bucket_bounds_.size()> duration_buckets_{};
+  std::array<std::uint64_t, bucket_bounds.size()> duration_buckets_{};
   std::uint64_t duration_count_ = 0;
   double duration_sum_ = 0.0;
   std::map<JobStatus, std::uint64_t> finished_by_outcome_;

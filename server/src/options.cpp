@@ -138,7 +138,8 @@ ParsedOptions parse_options(const std::vector<std::string>& args, const char* en
       value = args[++i];
     }
     if (const std::string problem = it->second(value); !problem.empty()) {
-      result.error = flag + " " + value + ": " + problem;
+      result.error = flag;
+      result.error.append(" ").append(value).append(": ").append(problem);
       return result;
     }
   }
