@@ -192,6 +192,15 @@ TEST_F(ServiceTest, FirstLineAnnouncesTheAddress) {
   EXPECT_EQ(client.Get("/health")->status, 200);
 }
 
+TEST_F(ServiceTest, BadArgumentsExitTwoAndHelpExitsZero) {
+  EXPECT_EQ(run_program({HMPM_SERVER_PATH, "--help"}, 10), 0);
+  EXPECT_EQ(run_program({HMPM_SERVER_PATH}, 10), 2);  // --db is required
+  EXPECT_EQ(
+      run_program({HMPM_SERVER_PATH, "--db", (dir_ / "x.sqlite").string(), "--port", "-1"}, 10), 2);
+  EXPECT_EQ(run_program({HMPM_SERVER_PATH, "--db", (dir_ / "x.sqlite").string(), "--bogus"}, 10),
+            2);
+}
+
 TEST_F(ServiceTest, SubmitPollAndResultsMatchTheCommandLine) {
   start({"--workers", "2"});
   auto client = server_->client();

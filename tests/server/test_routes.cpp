@@ -167,6 +167,9 @@ TEST_F(RoutesTest, SubmitPollAndDownloadResults) {
   EXPECT_TRUE(names.count("summary.json"));
   EXPECT_TRUE(names.count("series.json"));
   EXPECT_TRUE(names.count("series.csv"));
+  // Without --data-dir the files live beside the database, one folder per job.
+  EXPECT_EQ(service_->config().data_dir, dir_ / "db" / "results");
+  EXPECT_TRUE(std::filesystem::exists(dir_ / "db" / "results" / id / "series.json"));
 }
 
 TEST_F(RoutesTest, HostileBodiesGetProblemDocumentsAndTheServerKeepsAnswering) {
