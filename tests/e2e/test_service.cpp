@@ -408,13 +408,14 @@ TEST_F(ServiceTest, SigtermExitsZeroAndTheRunningJobResumesAfterRestart) {
   std::string id;
   {
     auto client = server_->client();
-    id = submit(client, long_spec("resumed", 40));
+    id = submit(client, long_spec("resumed", 100));
     ASSERT_EQ(
         status_of(poll_job(
             client, id, [](const Json& d) { return d.value("status", "") == "running"; }, 30)),
         "running");
   }
   EXPECT_EQ(server_->signal_and_wait(SIGTERM, 10), 0);
+  EXPECT_NE(server_->log().find("\"requeued\":true"), std::string::npos) << server_->log();
   start({"--workers", "1"});
   auto client = server_->client();
   const Json done = poll_job(client, id, is_final, 90);
