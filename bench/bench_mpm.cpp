@@ -108,7 +108,7 @@ int main(int argc, char** argv) {
               "particle_steps_per_second=%.4g state_bytes_per_particle=%.1f peak_rss_bytes_per_particle=%.1f\n",
               dim, nb, coupled ? 1 : 0,
               shape == hmpm::ShapeFunction::linear ? "linear" : (shape == hmpm::ShapeFunction::gimp ? "gimp" : "bspline"),
-              threads, static_cast<long long>(r.particles), static_cast<long long>(r.nodes),
+              r.threads, static_cast<long long>(r.particles), static_cast<long long>(r.nodes),
               static_cast<long long>(r.steps), r.particle_steps_per_second,
               static_cast<double>(r.state_bytes) / static_cast<double>(r.particles),
               static_cast<double>(rss) / static_cast<double>(r.particles));

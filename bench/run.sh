@@ -1,0 +1,146 @@
+#!/usr/bin/env bash
+# bench/run.sh — runs the benchmark matrix and rewrites the measured part of
+# docs/performance.md (between the bench:begin and bench:end markers).
+#
+#   bash bench/run.sh            # full matrix (about 10 minutes on 2 vCPU)
+#   bash bench/run.sh --quick    # a few rows, to check the script itself
+#   bash bench/run.sh --no-doc   # print the table, leave the doc alone
+#
+# Benchmarks, not tests: nothing here asserts a time. Run on a quiet machine;
+# every row is the best of REPEAT runs (default 2) to shave off interference.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+quick=0
+write_doc=1
+for arg in "$@"; do
+  case "$arg" in
+    --quick) quick=1 ;;
+    --no-doc) write_doc=0 ;;
+    *) echo "usage: bench/run.sh [--quick] [--no-doc]" >&2; exit 2 ;;
+  esac
+done
+repeat=${REPEAT:-2}
+build=${BUILD_DIR:-build-bench}
+
+cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=Release -DHMPM_BUILD_TESTS=OFF >/dev/null
+cmake --build "$build" --target bench_mpm -j"$(nproc)" >/dev/null
+bench="$build/bin/bench_mpm"
+
+# Side lengths in cells giving about 10k, 100k, 400k and 1M particles at 2
+# particles per cell per axis (2D: 4 per cell, 3D: 8 per cell).
+nb2d=(50 158 316 500)
+nb3d=(11 23 37 50)
+# Particle-steps per run: enough for a few seconds of time loop.
+work=40000000
+if ((quick)); then
+  nb2d=(50)
+  nb3d=(11)
+  work=4000000
+fi
+
+value() { sed -n "s/.* $1=\([^ ]*\).*/\1/p"; }
+
+# One row: best throughput over $repeat runs of bench_mpm with these flags.
+row() {
+  local label=$1
+  shift
+  local best="" line="" out
+  for ((r = 0; r < repeat; ++r)); do
+    out=$("$bench" "$@")
+    local ps
+    ps=$(value particle_steps_per_second <<<"$out")
+    if [[ -z $best ]] || awk -v a="$ps" -v b="$best" 'BEGIN{exit !(a > b)}'; then
+      best=$ps
+      line=$out
+    fi
+  done
+  local particles threads state rss
+  particles=$(value particles <<<"$line")
+  threads=$(value threads <<<"$line")
+  state=$(value state_bytes_per_particle <<<"$line")
+  rss=$(value peak_rss_bytes_per_particle <<<"$line")
+  printf '| %s | %s | %s | %.2f M | %.0f | %.0f |\n' "$label" "$particles" "$threads" \
+    "$(awk -v v="$best" 'BEGIN{print v / 1e6}')" "$state" "$rss"
+}
+
+steps_for() {  # particles-per-cell^dim * nb^dim -> steps for ~$work particle-steps
+  local n=$1
+  local s=$((work / n))
+  ((s < 20)) && s=20
+  echo "$s"
+}
+
+table() {
+  echo '| case | particles | threads | particle-steps/s | state B/particle | peak RSS B/particle |'
+  echo '|---|---:|---:|---:|---:|---:|'
+  local nb n
+  for coupled in "" "--coupled"; do
+    local kind=dry
+    [[ -n $coupled ]] && kind=coupled
+    for nb in "${nb2d[@]}"; do
+      n=$((4 * nb * nb))
+      # shellcheck disable=SC2086
+      row "2D $kind linear" --dim 2 --nb "$nb" --steps "$(steps_for $n)" --threads 1 $coupled
+    done
+    for nb in "${nb3d[@]}"; do
+      n=$((8 * nb * nb * nb))
+      # shellcheck disable=SC2086
+      row "3D $kind linear" --dim 3 --nb "$nb" --steps "$(steps_for $n)" --threads 1 $coupled
+    done
+  done
+  # Two threads at 400k particles (the quick run uses its single size).
+  local nb2=${nb2d[2]:-${nb2d[0]}} nb3=${nb3d[2]:-${nb3d[0]}}
+  for coupled in "" "--coupled"; do
+    local kind=dry
+    [[ -n $coupled ]] && kind=coupled
+    for t in 1 2; do
+      # shellcheck disable=SC2086
+      row "2D $kind linear" --dim 2 --nb "$nb2" --steps "$(steps_for $((4 * nb2 * nb2)))" --threads $t $coupled
+    done
+    for t in 1 2; do
+      # shellcheck disable=SC2086
+      row "3D $kind linear" --dim 3 --nb "$nb3" --steps "$(steps_for $((8 * nb3 * nb3 * nb3)))" --threads $t $coupled
+    done
+  done
+  # Shape functions at about 100k particles.
+  local nbs=${nb2d[1]:-${nb2d[0]}} nbs3=${nb3d[1]:-${nb3d[0]}}
+  for shape in gimp bspline; do
+    for coupled in "" "--coupled"; do
+      local kind=dry
+      [[ -n $coupled ]] && kind=coupled
+      # shellcheck disable=SC2086
+      row "2D $kind $shape" --dim 2 --nb "$nbs" --steps "$(steps_for $((4 * nbs * nbs)))" --threads 1 --shape $shape $coupled
+      # shellcheck disable=SC2086
+      row "3D $kind $shape" --dim 3 --nb "$nbs3" --steps "$(steps_for $((8 * nbs3 * nbs3 * nbs3)))" --threads 1 --shape $shape $coupled
+    done
+  done
+}
+
+machine() {
+  local cpu
+  cpu=$(sed -n 's/^model name[[:space:]]*: //p' /proc/cpuinfo | head -1)
+  echo "- Machine: $(nproc) vCPU, $cpu, $(awk '/MemTotal/ {printf "%.0f GiB", $2 / 1048576}' /proc/meminfo) RAM"
+  echo "- Compiler: $(c++ --version | head -1); Release (-O3, no -march=native)"
+  echo "- Commit: $(git rev-parse --short HEAD)$(git diff --quiet HEAD -- solver bench || echo ' (with local changes)'); measured $(date -u '+%Y-%m-%d %H:%M UTC')"
+  echo "- Command: \`bash bench/run.sh\` (best of $repeat runs per row; the time loop only, as in summary.json)"
+}
+
+result=$(
+  machine
+  echo
+  table
+)
+echo "$result"
+
+if ((write_doc && !quick)); then
+  doc=docs/performance.md
+  tmp=$(mktemp)
+  awk -v body="$result" '
+    /<!-- bench:begin -->/ { print; print body; skip = 1; next }
+    /<!-- bench:end -->/ { skip = 0 }
+    !skip { print }
+  ' "$doc" >"$tmp"
+  mv "$tmp" "$doc"
+  echo "bench/run.sh: updated $doc" >&2
+fi
