@@ -10,6 +10,8 @@
 # every row is the best of REPEAT runs (default 2) to shave off interference.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+# shellcheck source=bench/doc_section.sh
+source bench/doc_section.sh
 
 quick=0
 write_doc=1
@@ -134,13 +136,5 @@ result=$(
 echo "$result"
 
 if ((write_doc && !quick)); then
-  doc=docs/performance.md
-  tmp=$(mktemp)
-  awk -v body="$result" '
-    /<!-- bench:begin -->/ { print; print body; skip = 1; next }
-    /<!-- bench:end -->/ { skip = 0 }
-    !skip { print }
-  ' "$doc" >"$tmp"
-  mv "$tmp" "$doc"
-  echo "bench/run.sh: updated $doc" >&2
+  replace_doc_section bench "$result"
 fi

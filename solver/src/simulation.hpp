@@ -39,6 +39,7 @@
 #include "hmpm/problem.hpp"
 #include "hmpm/run.hpp"
 #include "materials.hpp"
+#include "objective_rate.hpp"
 #include "parallel.hpp"
 #include "particle_layout.hpp"
 #include "shape.hpp"
@@ -513,7 +514,7 @@ class Simulation {
       }
       const double tr = de[0] + de[1] + de[2];
       Voigt& sig = particles_.stress[p];
-      if constexpr (Dim >= 2) rotate_jaumann(sig, grad_v, dt);
+      if constexpr (Dim >= 2) rotate_jaumann<Dim>(sig, grad_v, dt);
       for (int c = 0; c < 3; ++c) sig[c] += mc.lambda * tr + 2.0 * mc.shear_modulus * de[c];
       for (int c = 3; c < 6; ++c) sig[c] += 2.0 * mc.shear_modulus * de[c];
       particles_.strain[p] += de;
@@ -569,26 +570,6 @@ class Simulation {
     }
     for (int a = 0; a < Dim; ++a)
       if (particles_.x[p][a] < grid_.origin[a] || particles_.x[p][a] > grid_max_[a]) fail_left_grid(p);
-  }
-
-  /// Objective (Jaumann) stress rate: sigma += dt (W sigma - sigma W) with
-  /// the spin W = (L - L^T)/2, so rigid rotations rotate the stress instead
-  /// of straining it. Vanishes for irrotational motion.
-  static inline void rotate_jaumann(Voigt& s, const Mat& grad_v, double dt) {
-    if constexpr (Dim == 2) {
-      const double w = 0.5 * (grad_v(0, 1) - grad_v(1, 0)) * dt;  // W_xy
-      const double dxx = 2.0 * w * s[3], dxy = w * (s[1] - s[0]);
-      s[0] += dxx;
-      s[1] -= dxx;
-      s[3] += dxy;
-    } else if constexpr (Dim == 3) {
-      Eigen::Matrix3d sig;
-      sig << s[0], s[3], s[5], s[3], s[1], s[4], s[5], s[4], s[2];
-      const Eigen::Matrix3d w = 0.5 * (grad_v - grad_v.transpose()) * dt;
-      const Eigen::Matrix3d d = w * sig - sig * w;
-      s[0] += d(0, 0); s[1] += d(1, 1); s[2] += d(2, 2);
-      s[3] += d(0, 1); s[4] += d(1, 2); s[5] += d(2, 0);
-    }
   }
 
   // ------------------------------------------------------------ failures
