@@ -22,10 +22,10 @@ using Keys = std::span<const std::string_view>;
 // ---------------------------------------------------------------- key tables
 // The accepted keys of every object; spec_object_keys() exposes them so the
 // JSON Schema test can compare.
-constexpr std::string_view kTop[] = {"name",           "description",     "dimension", "grid",
-                                     "shape_function", "materials",       "bodies",    "gravity",
-                                     "boundaries",     "tractions",       "time",      "output",
-                                     "local_damping",  "gravity_constant"};
+constexpr std::string_view kTop[] = {
+    "name",          "description",      "dimension",    "grid",      "shape_function", "materials",
+    "bodies",        "gravity",          "boundaries",   "tractions", "time",           "output",
+    "local_damping", "gravity_constant", "initial_state"};
 constexpr std::string_view kTopRequired[] = {"dimension", "grid", "materials", "bodies", "time"};
 constexpr std::string_view kGrid[] = {"min", "max", "cells"};
 constexpr std::string_view kMaterial[] = {"model",         "density",          "youngs_modulus",
@@ -44,10 +44,12 @@ constexpr std::string_view kBody[] = {"material", "box", "particles_per_cell", "
 constexpr std::string_view kBodyRequired[] = {"material", "box"};
 constexpr std::string_view kBox[] = {"min", "max"};
 constexpr std::string_view kInitial[] = {"velocity", "pore_pressure", "effective_stress"};
-constexpr std::string_view kBoundary[] = {"nodes", "velocity", "pore_pressure"};
+constexpr std::string_view kBoundary[] = {"nodes", "velocity", "pore_pressure", "rigid"};
 constexpr std::string_view kBoundaryRequired[] = {"nodes"};
 constexpr std::string_view kSelection[] = {"box"};
 constexpr std::string_view kTraction[] = {"particles", "face", "traction"};
+constexpr std::string_view kInitialState[] = {"geostatic"};
+constexpr std::string_view kGeostatic[] = {"water_table", "k0"};
 constexpr std::string_view kTime[] = {"end", "dt", "courant"};
 constexpr std::string_view kTimeRequired[] = {"end"};
 constexpr std::string_view kOutput[] = {"series", "snapshots"};
@@ -151,6 +153,7 @@ class JobParser {
   void parse_boundary(const json& j, const std::string& path);
   void parse_traction(const json& j, const std::string& path);
   void parse_time(const json& j, const std::string& path);
+  void parse_initial_state(const json& j, const std::string& path);
   void parse_output(const json& j, const std::string& path);
   std::vector<Field> parse_fields(const json& j, const std::string& path);
   std::optional<Box> parse_box(const json& j, const std::string& path);
@@ -255,6 +258,7 @@ void JobParser::parse_root(const json& root) {
         parse_traction(t[i], child_pointer("/tractions", i));
   }
   if (root.contains("time")) parse_time(root["time"], "/time");
+  if (root.contains("initial_state")) parse_initial_state(root["initial_state"], "/initial_state");
   if (root.contains("output")) parse_output(root["output"], "/output");
 
   if (any_pore_pressure_bc_ &&
@@ -554,8 +558,8 @@ void JobParser::parse_boundary(const json& j, const std::string& path) {
       }
     }
   }
-  if (!j.contains("velocity") && !j.contains("pore_pressure"))
-    r_.error(path, "needs 'velocity' and/or 'pore_pressure'");
+  if (!j.contains("velocity") && !j.contains("pore_pressure") && !j.contains("rigid"))
+    r_.error(path, "needs 'velocity', 'pore_pressure' and/or 'rigid'");
   if (j.contains("velocity")) {
     const json& v = j["velocity"];
     const std::string vp = path + "/velocity";
@@ -566,6 +570,23 @@ void JobParser::parse_boundary(const json& j, const std::string& path) {
           b.velocity[a] = std::move(*f);
           b.has_velocity = true;
         }
+      }
+    }
+  }
+  if (j.contains("rigid")) {
+    const json& v = j["rigid"];
+    const std::string vp = path + "/rigid";
+    if (r_.per_axis(v, vp, dim_, "true or false")) {
+      for (std::size_t a = 0; a < v.size() && a < 3; ++a) {
+        const std::string ap = child_pointer(vp, a);
+        if (!v[a].is_boolean()) {
+          r_.error(ap, std::string("expected true or false, got ") + v[a].type_name());
+          continue;
+        }
+        b.rigid[a] = v[a].get<bool>();
+        if (b.rigid[a] && b.velocity[a])
+          r_.error(ap, "is true but velocity/" + std::to_string(a) +
+                           " prescribes that component; a rigid tie needs it free");
       }
     }
   }
@@ -611,6 +632,40 @@ void JobParser::parse_time(const json& j, const std::string& path) {
   r_.number_at(j, path, "end", Range::positive(), p_.time.end);
   r_.number_at(j, path, "dt", Range::positive(), p_.time.dt);
   r_.number_at(j, path, "courant", {0.0, 1.0, true, false}, p_.time.courant);
+}
+
+void JobParser::parse_initial_state(const json& j, const std::string& path) {
+  if (!r_.object(j, path, kInitialState)) return;
+  if (!j.contains("geostatic")) return;
+  const json& g = j["geostatic"];
+  const std::string gp = path + "/geostatic";
+  if (!r_.object(g, gp, kGeostatic)) return;
+  Geostatic geo;
+  r_.number_at(g, gp, "water_table", Range::any(), geo.water_table);
+  if (g.contains("k0")) {
+    const json& k = g["k0"];
+    const std::string kp = gp + "/k0";
+    if (k.is_object()) {
+      geo.material_k0.resize(p_.materials.size());
+      for (const auto& [name, value] : k.items()) {
+        const std::string mp = child_pointer(kp, name);
+        const auto it = material_index_.find(name);
+        if (it == material_index_.end()) {
+          r_.error(mp, "names no material");
+          continue;
+        }
+        if (auto v = r_.number(value, mp, Range::non_negative()))
+          geo.material_k0[static_cast<std::size_t>(it->second)] = *v;
+      }
+    } else if (k.is_number()) {
+      if (auto v = r_.number(k, kp, Range::non_negative())) geo.k0 = *v;
+    } else {
+      r_.error(kp, std::string("expected a number >= 0 or an object of material name -> number, "
+                               "got ") +
+                       k.type_name());
+    }
+  }
+  p_.initial_state.geostatic = std::move(geo);
 }
 
 std::vector<Field> JobParser::parse_fields(const json& j, const std::string& path) {
@@ -946,6 +1001,8 @@ const std::vector<SpecObjectKeys>& spec_object_keys() {
         entry("/tractions/*", kTraction),
         entry("/tractions/*/particles", kSelection),
         entry("/tractions/*/particles/box", kBox),
+        entry("/initial_state", kInitialState),
+        entry("/initial_state/geostatic", kGeostatic),
         entry("/time", kTime),
         entry("/output", kOutput),
         entry("/output/series", kSeries),

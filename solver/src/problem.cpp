@@ -7,6 +7,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "geostatic.hpp"
 #include "hmpm/problem.hpp"
 #include "hmpm/run.hpp"
 #include "materials.hpp"
@@ -237,6 +238,7 @@ std::vector<ProblemIssue> check_problem(const Problem& problem) {
           "particle " + std::to_string(p) + " does not exist; there are " + std::to_string(n) +
               " particles (0.." + std::to_string(n - 1) + ")");
   }
+  for (ProblemIssue& issue : check_geostatic(problem)) issues.push_back(std::move(issue));
   return issues;
 }
 

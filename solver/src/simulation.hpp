@@ -36,6 +36,7 @@
 #include <string>
 #include <vector>
 
+#include "geostatic.hpp"
 #include "hmpm/problem.hpp"
 #include "hmpm/run.hpp"
 #include "materials.hpp"
@@ -60,6 +61,7 @@ class Simulation {
     setup_particles();
     setup_boundaries();
     setup_tractions();
+    setup_geostatic();
   }
 
   RunResult run(const RunOptions& options);
@@ -153,8 +155,72 @@ class Simulation {
           }
         velocity_bcs_.push_back(std::move(vc));
       }
+      if (b.rigid[0] || b.rigid[1] || b.rigid[2]) rigid_ties_.push_back({nodes, b.rigid});
       if (b.pore_pressure && fluid_) pressure_bcs_.push_back({std::move(nodes), &*b.pore_pressure});
     }
+  }
+
+  /// Geostatic initial state (Problem::initial_state.geostatic): effective
+  /// stress and pore pressure from the layered closed form at every particle.
+  /// The reported pressure is the closed form; the transported pressure state
+  /// is then corrected so that the nodal pressure the first step computes
+  /// from it (a storage-weighted average, biased by a fraction of a cell at
+  /// boundary nodes where particles lie on one side only) is the hydrostatic
+  /// nodal field itself. Its interpolation then gives back the closed form at
+  /// every particle, so pressure, effective stress and weight balance at
+  /// every node and the ground stays at rest.
+  void setup_geostatic() {
+    if (!problem_.initial_state.geostatic) return;
+    const GeostaticState g = geostatic_state(problem_);
+    for (std::size_t p = 0; p < particles_.size(); ++p) {
+      geostatic_voigt(g, p, particles_.stress[p].data());
+      if (fluid_ && constants_[particles_.material[p]].saturated) {
+        particles_.pressure[p] = g.pressure[p];
+        particles_.pressure_out[p] = g.pressure[p];
+      }
+    }
+    if (fluid_) balance_initial_pressure_state();
+  }
+
+  /// Richardson iteration on the particle pressure state s until the nodal
+  /// pressure mapped from it interpolates back to the reported pressure at
+  /// every saturated particle: s += p_out - N W s (N W is similar to a
+  /// symmetric matrix with eigenvalues in [0, 1], so it converges wherever
+  /// the target is an interpolated nodal field). Set-up only.
+  void balance_initial_pressure_state() {
+    double scale = 0.0;
+    for (double v : particles_.pressure_out) scale = std::max(scale, std::abs(v));
+    if (scale == 0.0) return;
+    StencilT s;
+    for (int iteration = 0; iteration < 500; ++iteration) {
+      std::fill(grid_.storage.begin(), grid_.storage.end(), 0.0);
+      std::fill(grid_.pressure.begin(), grid_.pressure.end(), 0.0);
+      for (std::size_t p = 0; p < particles_.size(); ++p) {
+        const std::uint16_t mat = particles_.material[p];
+        if (!constants_[mat].saturated) continue;
+        stencil_of<false>(p, s);
+        const double n = particles_.porosity[p];
+        const double qv = ((1.0 - n) * inv_ks_[mat] + n * inv_kf_[mat]) * particles_.volume[p];
+        for (int k = 0; k < StencilT::N; ++k) {
+          grid_.storage[s.node[k]] += s.w[k] * qv;
+          grid_.pressure[s.node[k]] += s.w[k] * qv * particles_.pressure[p];
+        }
+      }
+      compute_nodal_pressure(0.0);
+      double residual = 0.0;
+      for (std::size_t p = 0; p < particles_.size(); ++p) {
+        if (!constants_[particles_.material[p]].saturated) continue;
+        stencil_of<false>(p, s);
+        double p_hat = 0.0;
+        for (int k = 0; k < StencilT::N; ++k) p_hat += s.w[k] * grid_.pressure[s.node[k]];
+        const double r = particles_.pressure_out[p] - p_hat;
+        particles_.pressure[p] += r;
+        residual = std::max(residual, std::abs(r));
+      }
+      if (residual <= 1e-15 * scale) break;
+    }
+    std::fill(grid_.storage.begin(), grid_.storage.end(), 0.0);
+    std::fill(grid_.pressure.begin(), grid_.pressure.end(), 0.0);
   }
 
   void setup_tractions() {
@@ -427,6 +493,22 @@ class Simulation {
       grid_.accel[i] = f / m;
       grid_.velocity[i] = v0 + dt * grid_.accel[i];
     }
+    for (const RigidTie& tie : rigid_ties_)
+      for (int a = 0; a < Dim; ++a) {
+        if (!tie.axes[a]) continue;
+        double mass = 0.0, momentum = 0.0;
+        for (std::int64_t i : tie.nodes) {
+          mass += grid_.mass[i];
+          momentum += grid_.mass[i] * grid_.velocity[i][a];
+        }
+        if (!(mass > 0.0)) continue;
+        const double v = momentum / mass;
+        for (std::int64_t i : tie.nodes) {
+          if (grid_.mass[i] <= mass_tolerance_) continue;
+          grid_.velocity[i][a] = v;
+          grid_.accel[i][a] = (v - grid_.momentum[i][a] / grid_.mass[i]) / dt;
+        }
+      }
     for (const VelocityConstraint& bc : velocity_bcs_) {
       for (int a = 0; a < Dim; ++a) {
         if (!bc.fixed[a]) continue;
@@ -469,10 +551,26 @@ class Simulation {
   }
 
   void compute_remapped_nodal_velocity(double t_new) {
+    for (RigidTie& tie : rigid_ties_)
+      for (int a = 0; a < Dim; ++a) {
+        if (!tie.axes[a]) continue;
+        double mass = 0.0, momentum = 0.0;
+        for (std::int64_t i : tie.nodes) {
+          mass += grid_.mass[i];
+          momentum += grid_.remap[i][a];
+        }
+        tie.remapped[a] = mass > 0.0 ? momentum / mass : 0.0;
+      }
     for (std::int64_t i = 0; i < grid_.count; ++i) {
       const double m = grid_.mass[i];
       grid_.remap[i] = m > mass_tolerance_ ? Vec(grid_.remap[i] / m) : Vec::Zero();
     }
+    for (const RigidTie& tie : rigid_ties_)
+      for (int a = 0; a < Dim; ++a) {
+        if (!tie.axes[a]) continue;
+        for (std::int64_t i : tie.nodes)
+          if (grid_.mass[i] > mass_tolerance_) grid_.remap[i][a] = tie.remapped[a];
+      }
     for (const VelocityConstraint& bc : velocity_bcs_)
       for (int a = 0; a < Dim; ++a) {
         if (!bc.fixed[a]) continue;
@@ -621,6 +719,12 @@ class Simulation {
     std::array<bool, 3> fixed{false, false, false};
     std::array<const FieldOfTime*, 3> fn{nullptr, nullptr, nullptr};
   };
+  /// Nodes sharing one velocity component per marked axis (rigid plate).
+  struct RigidTie {
+    std::vector<std::int64_t> nodes;
+    std::array<bool, 3> axes{false, false, false};
+    std::array<double, 3> remapped{0.0, 0.0, 0.0};  ///< scratch: tied re-mapped velocity
+  };
   struct PressureConstraint {
     std::vector<std::int64_t> nodes;
     const FieldOfTime* fn = nullptr;
@@ -641,6 +745,7 @@ class Simulation {
   std::vector<double> inv_ks_, inv_kf_;
   std::vector<VelocityConstraint> velocity_bcs_;
   std::vector<PressureConstraint> pressure_bcs_;
+  std::vector<RigidTie> rigid_ties_;
   std::vector<TractionLoad> tractions_;
   Vec gravity_ = Vec::Zero();
   Vec grid_max_ = Vec::Zero();

@@ -1,6 +1,7 @@
 // test_parse_job.cpp — a valid spec becomes exactly the Problem it describes:
 // every field, the defaults of the contract, compiled expressions, resolved
 // particle selections, the cost estimate and the known-key table.
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <variant>
@@ -14,6 +15,7 @@
 namespace hmpm::api {
 namespace {
 
+using json = nlohmann::json;
 using testing::read_text;
 using testing::source_path;
 
@@ -201,6 +203,91 @@ TEST(ParseJob, MediaTypes) {
   EXPECT_EQ(media_type_for("snapshots.pvd"), "application/xml");
   EXPECT_EQ(media_type_for("snapshot_0001.vtu"), "application/xml");
   EXPECT_EQ(media_type_for("x.bin"), "application/octet-stream");
+}
+
+// The geostatic block: valid-2d's saturated sand (y in [0, 0.5]) under a dry
+// layer (to y = 0.75), with the table at the sand's top.
+json geostatic_spec(const json& block) {
+  json spec = json::parse(read_text(source_path("tests/api/data/valid-2d.json")));
+  spec["bodies"][0]["initial"].erase("pore_pressure");
+  spec["bodies"][0]["initial"].erase("effective_stress");
+  spec["initial_state"] = {{"geostatic", block}};
+  return spec;
+}
+
+TEST(ParseJob, GeostaticBlockBecomesTypedValues) {
+  {
+    const ParsedJob job = parse_valid(
+        geostatic_spec(json::parse(R"({"water_table": 0.5, "k0": {"sand": 0.45}})")).dump());
+    const Problem& p = job.problem;
+    ASSERT_TRUE(p.initial_state.geostatic.has_value());
+    const Geostatic& g = *p.initial_state.geostatic;
+    ASSERT_TRUE(g.water_table.has_value());
+    EXPECT_DOUBLE_EQ(*g.water_table, 0.5);
+    EXPECT_FALSE(g.k0.has_value());
+    ASSERT_EQ(g.material_k0.size(), p.materials.size());
+    const auto sand = static_cast<std::size_t>(p.bodies.at(0).material);
+    const auto other = static_cast<std::size_t>(p.bodies.at(1).material);
+    ASSERT_TRUE(g.material_k0[sand].has_value());
+    EXPECT_DOUBLE_EQ(*g.material_k0[sand], 0.45);
+    EXPECT_FALSE(g.material_k0[other].has_value());
+  }
+  {
+    const ParsedJob job =
+        parse_valid(geostatic_spec(json::parse(R"({"water_table": 0.5, "k0": 0.6})")).dump());
+    const Geostatic& g = job.problem.initial_state.geostatic.value();
+    ASSERT_TRUE(g.k0.has_value());
+    EXPECT_DOUBLE_EQ(*g.k0, 0.6);
+    EXPECT_TRUE(g.material_k0.empty());
+  }
+  // Absent block: no geostatic state.
+  EXPECT_FALSE(parse_valid(read_text(source_path("tests/api/data/valid-2d.json")))
+                   .problem.initial_state.geostatic.has_value());
+}
+
+TEST(ParseJob, GeostaticPhysicalChecksReportTheirPointers) {
+  auto errors_of = [](const json& spec) {
+    const ParseResult r = parse_job(spec.dump());
+    std::vector<std::string> out;
+    for (const auto& e : r.errors) out.push_back(e.path + ": " + e.message);
+    return out;
+  };
+  auto expect_error = [&](const json& spec, const std::string& path, const std::string& part) {
+    const auto errors = errors_of(spec);
+    const bool found = std::any_of(errors.begin(), errors.end(), [&](const std::string& e) {
+      return e.rfind(path + ": ", 0) == 0 && e.find(part) != std::string::npos;
+    });
+    std::string all;
+    for (const auto& e : errors) all += "  " + e + "\n";
+    EXPECT_TRUE(found) << "wanted " << path << " (" << part << "), got:\n" << all;
+  };
+  // Below the top of the saturated sand: sand would lie above the table.
+  expect_error(geostatic_spec({{"water_table", 0.4}}), "/initial_state/geostatic/water_table",
+               "fully saturated");
+  // Above the ground surface (0.75): free water is not modelled.
+  expect_error(geostatic_spec({{"water_table", 0.9}}), "/initial_state/geostatic/water_table",
+               "above the ground surface");
+  // A saturated material needs a table.
+  expect_error(geostatic_spec(json::object()), "/initial_state/geostatic", "needs 'water_table'");
+  // The ground is layered across gravity.
+  json tilted = geostatic_spec({{"water_table", 0.5}});
+  tilted["gravity"] = {-1.0, -9.81};
+  expect_error(tilted, "/gravity", "exactly one non-zero component");
+  // The water table is a number.
+  expect_error(geostatic_spec({{"water_table", "high"}}), "/initial_state/geostatic/water_table",
+               "got string");
+}
+
+TEST(ParseJob, RigidBoundaryAxes) {
+  json spec = json::parse(read_text(source_path("tests/api/data/valid-2d.json")));
+  spec["boundaries"].push_back(json::parse(
+      R"({"nodes": {"box": {"min": [0, 0.75], "max": [1, 0.75]}}, "rigid": [false, true]})"));
+  const ParsedJob job = parse_valid(spec.dump());
+  const Boundary& b = job.problem.boundaries.back();
+  EXPECT_FALSE(b.rigid[0]);
+  EXPECT_TRUE(b.rigid[1]);
+  EXPECT_FALSE(b.has_velocity);
+  EXPECT_FALSE(b.pore_pressure.has_value());
 }
 
 }  // namespace

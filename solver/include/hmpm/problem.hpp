@@ -121,6 +121,11 @@ struct Boundary {
   std::array<std::optional<FieldOfTime>, 3> velocity;
   bool has_velocity = false;  ///< any velocity component prescribed
   std::optional<FieldOfTime> pore_pressure;
+  /// Axes along which the selected nodes move as one rigid, frictionless
+  /// plate: each step their momenta and forces are summed, so they share one
+  /// velocity component (Mandel's plates). A velocity prescribed on the same
+  /// axis by any boundary wins.
+  std::array<bool, 3> rigid{false, false, false};
 };
 
 /// Surface load on one face of the particles inside `particles`.
@@ -130,6 +135,37 @@ struct Traction {
   int axis = 0;   ///< face normal axis: 0 = x, 1 = y, 2 = z
   int side = +1;  ///< +1 for "x+", -1 for "x-"
   std::array<FieldOfTime, 3> traction;  ///< Pa, per axis
+};
+
+/// Geostatic initial state of horizontally layered ground (verification §6).
+/// The vertical axis is the axis of gravity (the only non-zero component);
+/// "above" is against gravity. At every particle, from the bodies stacked
+/// above it in its column (each with its mixture density rho, constant per
+/// body):
+///   total vertical stress  sigma_v  = -|g| * integral of rho up to the ground surface
+///   pore pressure          p        = rho_f |g| * (depth below the water table)
+///                                     (materials with `hydraulic`; 0 for dry ones)
+///   effective stress       sigma'_v = sigma_v + p,  sigma'_h = K0 sigma'_v
+///                          (both horizontal axes), no shear.
+/// Dry materials (no `hydraulic`) model the ground above the water table
+/// with their bulk density; every material with `hydraulic` must lie below
+/// the table (the u-p model is fully saturated) and the table must not lie
+/// above the ground surface. check_problem reports violations.
+struct Geostatic {
+  /// Water table: coordinate along the vertical axis, m. Absent: no free
+  /// water, so no material may have `hydraulic`.
+  std::optional<double> water_table;
+  /// K0 = sigma'_h / sigma'_v for every material; absent: nu/(1-nu) of each
+  /// material (the at-rest ratio of laterally confined linear elasticity).
+  std::optional<double> k0;
+  /// Per-material K0 (index = material), overriding `k0`; empty or
+  /// std::nullopt entries fall back to `k0`.
+  std::vector<std::optional<double>> material_k0;
+};
+
+/// Procedures that set the initial state of all bodies together.
+struct InitialState {
+  std::optional<Geostatic> geostatic;
 };
 
 struct TimeControl {
@@ -180,6 +216,7 @@ struct Problem {
   double gravity_constant = 9.81;
   /// Local (Cundall) damping coefficient in [0, 1); 0 = none.
   double local_damping = 0.0;
+  InitialState initial_state;
 };
 
 }  // namespace hmpm

@@ -1,0 +1,230 @@
+// geostatic.cpp — the geostatic initial state: checks and the layered
+// integral over each particle's column (see geostatic.hpp).
+#include "geostatic.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "materials.hpp"
+#include "particle_layout.hpp"
+
+namespace hmpm {
+
+namespace {
+
+/// The space a body's particles fill (whole cells), and its density.
+struct BodyExtent {
+  Vec3 lo{0, 0, 0}, hi{0, 0, 0};
+  bool empty = true;
+  double density = 0.0;  ///< mixture density, kg/m^3
+  bool hydraulic = false;
+};
+
+/// Where gravity points: the vertical axis, "up" (+1 when gravity points to
+/// -axis) and |g|. axis = -1 when gravity is not along exactly one axis.
+struct Vertical {
+  int axis = -1;
+  double up = 1.0;
+  double g = 0.0;
+};
+
+Vertical vertical_of(const Problem& problem) {
+  Vertical v;
+  int nonzero = 0;
+  for (int a = 0; a < problem.dimension; ++a)
+    if (problem.gravity[a] != 0.0) {
+      ++nonzero;
+      v.axis = a;
+    }
+  if (nonzero != 1) return Vertical{};
+  v.up = problem.gravity[v.axis] < 0 ? 1.0 : -1.0;
+  v.g = std::abs(problem.gravity[v.axis]);
+  return v;
+}
+
+std::vector<BodyExtent> body_extents(const Problem& problem) {
+  std::vector<BodyExtent> out;
+  for (const Body& body : problem.bodies) {
+    BodyExtent e;
+    const BodyLayout layout = body_layout(problem, body);
+    e.empty = layout.count == 0;
+    for (int a = 0; a < problem.dimension && !e.empty; ++a) {
+      const double h = (problem.grid.max[a] - problem.grid.min[a]) / problem.grid.cells[a];
+      const double half = 0.5 * h / std::max(body.particles_per_cell, 1);
+      e.lo[a] = layout.coords[a].front() - half;
+      e.hi[a] = layout.coords[a].back() + half;
+    }
+    if (body.material >= 0 && body.material < static_cast<int>(problem.materials.size())) {
+      const Material& m = problem.materials[static_cast<std::size_t>(body.material)];
+      e.density = material_constants(m, problem.gravity_constant).mixture_density;
+      e.hydraulic = m.hydraulic.has_value();
+    }
+    out.push_back(e);
+  }
+  return out;
+}
+
+/// Elevation interval [bottom, top] of a body along "up".
+std::pair<double, double> elevations(const BodyExtent& e, const Vertical& v) {
+  const double a = v.up * e.lo[v.axis], b = v.up * e.hi[v.axis];
+  return {std::min(a, b), std::max(a, b)};
+}
+
+/// Whether the column through x (horizontal coordinates) crosses body e.
+bool covers(const BodyExtent& e, const Vec3& x, const Vertical& v, int dim) {
+  if (e.empty) return false;
+  for (int a = 0; a < dim; ++a)
+    if (a != v.axis && (x[a] < e.lo[a] || x[a] > e.hi[a])) return false;
+  return true;
+}
+
+/// Elevation of the ground surface over the column through x.
+double surface_at(const std::vector<BodyExtent>& extents, const Vec3& x, const Vertical& v,
+                  int dim) {
+  double top = -std::numeric_limits<double>::infinity();
+  for (const BodyExtent& e : extents)
+    if (covers(e, x, v, dim)) top = std::max(top, elevations(e, v).second);
+  return top;
+}
+
+std::string fmt(double x) {
+  std::ostringstream o;
+  o.precision(6);
+  o << x;
+  return o.str();
+}
+
+}  // namespace
+
+std::vector<ProblemIssue> check_geostatic(const Problem& problem) {
+  std::vector<ProblemIssue> issues;
+  if (!problem.initial_state.geostatic) return issues;
+  const Geostatic& geo = *problem.initial_state.geostatic;
+  const std::string where = "initial_state/geostatic";
+  const Vertical v = vertical_of(problem);
+  if (v.axis < 0) {
+    issues.push_back({"gravity",
+                      "must have exactly one non-zero component for "
+                      "initial_state.geostatic: the ground is layered across gravity"});
+    return issues;
+  }
+  for (std::size_t b = 0; b < problem.bodies.size(); ++b) {
+    const InitialFields& init = problem.bodies[b].initial;
+    const std::string w = "bodies/" + std::to_string(b) + "/initial/";
+    if (init.pore_pressure)
+      issues.push_back({w + "pore_pressure",
+                        "conflicts with initial_state.geostatic, which sets "
+                        "the initial pore pressure of every body"});
+    if (std::any_of(init.effective_stress.begin(), init.effective_stress.end(),
+                    [](const FieldOfPosition& f) { return static_cast<bool>(f); }))
+      issues.push_back({w + "effective_stress",
+                        "conflicts with initial_state.geostatic, which "
+                        "sets the initial effective stress of every body"});
+  }
+  const Material* fluid = nullptr;
+  for (const Material& m : problem.materials) {
+    if (!m.hydraulic) continue;
+    if (fluid && fluid->hydraulic->fluid_density != m.hydraulic->fluid_density)
+      issues.push_back({"materials/" + m.name + "/hydraulic/fluid_density",
+                        "differs from that of material '" + fluid->name +
+                            "': a geostatic state needs one pore fluid (one hydrostatic "
+                            "pressure)"});
+    if (!fluid) fluid = &m;
+  }
+  const std::vector<BodyExtent> extents = body_extents(problem);
+  const int dim = problem.dimension;
+  const char* axis_name[] = {"x", "y", "z"};
+  for (std::size_t b = 0; b < extents.size(); ++b) {
+    const BodyExtent& e = extents[b];
+    if (e.empty || !e.hydraulic) continue;
+    const std::string body = "body " + std::to_string(b);
+    if (!geo.water_table) {
+      issues.push_back({where, "needs 'water_table': " + body +
+                                   " is of a material with 'hydraulic' (saturated)"});
+      break;
+    }
+    const double table = v.up * *geo.water_table;
+    const auto [bottom, top] = elevations(e, v);
+    const double tol = 1e-9 * (problem.grid.max[v.axis] - problem.grid.min[v.axis]);
+    if (top > table + tol)
+      issues.push_back(
+          {where + "/water_table",
+           "is " + fmt(*geo.water_table) + " but " + body +
+               " (a material with 'hydraulic') reaches " + axis_name[v.axis] + " = " +
+               fmt(v.up * top) +
+               ": the u-p model is fully saturated, so ground above the water table must be a "
+               "material without 'hydraulic' (with the bulk density of the unsaturated soil)"});
+    // The table must not lie above the ground surface of any column through
+    // this body: free water above the ground is not modelled.
+    const BodyLayout layout = body_layout(problem, problem.bodies[b]);
+    const std::vector<double> none{0.0};
+    const std::vector<double>& xs = v.axis == 0 ? none : layout.coords[0];
+    const std::vector<double>& ys = (dim < 2 || v.axis == 1) ? none : layout.coords[1];
+    const std::vector<double>& zs = (dim < 3 || v.axis == 2) ? none : layout.coords[2];
+    bool reported = false;
+    for (double z : zs) {
+      for (double y : ys) {
+        for (double x : xs) {
+          const Vec3 at{x, y, z};
+          const double surface = surface_at(extents, at, v, dim);
+          if (table > surface + tol) {
+            issues.push_back({where + "/water_table",
+                              "is " + fmt(*geo.water_table) + ", above the ground surface " +
+                                  axis_name[v.axis] + " = " + fmt(v.up * surface) + " over " +
+                                  body +
+                                  ": free water above the ground is not modelled; lower the table "
+                                  "to the surface and load the surface with a traction instead"});
+            reported = true;
+            break;
+          }
+        }
+        if (reported) break;
+      }
+      if (reported) break;
+    }
+  }
+  return issues;
+}
+
+GeostaticState geostatic_state(const Problem& problem) {
+  const Geostatic& geo = *problem.initial_state.geostatic;
+  const Vertical v = vertical_of(problem);
+  const std::vector<BodyExtent> extents = body_extents(problem);
+  const int dim = problem.dimension;
+  GeostaticState out;
+  out.vertical_axis = v.axis;
+  const std::vector<Vec3> positions = initial_positions(problem);
+  out.vertical.resize(positions.size());
+  out.horizontal.resize(positions.size());
+  out.pressure.assign(positions.size(), 0.0);
+  const double table = geo.water_table ? v.up * *geo.water_table : 0.0;
+  std::size_t p = 0;
+  for (std::size_t b = 0; b < problem.bodies.size(); ++b) {
+    const Material& m = problem.materials[static_cast<std::size_t>(problem.bodies[b].material)];
+    const std::size_t mat = static_cast<std::size_t>(problem.bodies[b].material);
+    double k0 = geo.k0.value_or(m.poisson_ratio / (1.0 - m.poisson_ratio));
+    if (mat < geo.material_k0.size() && geo.material_k0[mat]) k0 = *geo.material_k0[mat];
+    const std::int64_t count = body_layout(problem, problem.bodies[b]).count;
+    for (std::int64_t k = 0; k < count; ++k, ++p) {
+      const Vec3& x = positions[p];
+      const double elevation = v.up * x[v.axis];
+      // Weight of the column above the particle, per unit area.
+      double weight = 0.0;
+      for (const BodyExtent& e : extents) {
+        if (!covers(e, x, v, dim)) continue;
+        const auto [bottom, top] = elevations(e, v);
+        const double from = std::max(bottom, elevation);
+        if (top > from) weight += e.density * v.g * (top - from);
+      }
+      const double pressure =
+          m.hydraulic ? m.hydraulic->fluid_density * v.g * (table - elevation) : 0.0;
+      out.pressure[p] = pressure;
+      out.vertical[p] = -weight + pressure;
+      out.horizontal[p] = k0 * out.vertical[p];
+    }
+  }
+  return out;
+}
+
+}  // namespace hmpm
