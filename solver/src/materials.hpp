@@ -1,17 +1,31 @@
 // materials.hpp — material constants derived once from a Material (internal).
 //
 // Everything the hot loops need is precomputed here, so the time step never
-// recomputes moduli or looks anything up by name.
+// recomputes moduli or looks anything up by name. The constitutive model is
+// a small enum: the stress update branches on it per particle and calls the
+// closed-form return mapping of constitutive.hpp with the constants stored
+// here (no virtual call, nothing derived from angles in the loop).
 #pragma once
 
 #include <cmath>
+#include <cstdint>
 #include <limits>
+#include <type_traits>
+#include <variant>
 
+#include "constitutive.hpp"
 #include "hmpm/problem.hpp"
 
 namespace hmpm {
 
+/// Which stress update a material uses after the elastic trial.
+enum class Model : std::uint8_t { linear_elastic, mohr_coulomb, drucker_prager };
+
 struct MaterialConstants {
+  Model model = Model::linear_elastic;
+  constitutive::Elastic elastic{0.0, 0.0};              ///< the trial's lambda and G
+  constitutive::MohrCoulombConstants mohr_coulomb;      ///< used when model == mohr_coulomb
+  constitutive::DruckerPragerConstants drucker_prager;  ///< used when model == drucker_prager
   double lambda = 0.0;               ///< Lame's first parameter, Pa
   double shear_modulus = 0.0;        ///< G, Pa
   double constrained_modulus = 0.0;  ///< E(1-nu)/((1+nu)(1-2nu)), Pa
@@ -32,6 +46,19 @@ inline MaterialConstants material_constants(const Material& m, double gravity_co
   c.constrained_modulus = c.lambda + 2 * c.shear_modulus;
   c.mixture_density = m.density;
   c.undrained_p_modulus = c.constrained_modulus;
+  c.elastic = {c.lambda, c.shear_modulus};
+  std::visit(
+      [&c](const auto& model) {
+        using T = std::decay_t<decltype(model)>;
+        if constexpr (std::is_same_v<T, MohrCoulomb>) {
+          c.model = Model::mohr_coulomb;
+          c.mohr_coulomb = constitutive::make_mohr_coulomb(model);
+        } else if constexpr (std::is_same_v<T, DruckerPrager>) {
+          c.model = Model::drucker_prager;
+          c.drucker_prager = constitutive::make_drucker_prager(model);
+        }
+      },
+      m.plasticity);
   if (m.hydraulic) {
     const Hydraulic& h = *m.hydraulic;
     c.saturated = true;

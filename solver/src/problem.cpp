@@ -215,6 +215,21 @@ std::vector<ProblemIssue> check_problem(const Problem& problem) {
       add(w + "box", "contains no whole grid cell, so no particles; a body fills the cells "
                      "that lie entirely inside its box");
   }
+  for (std::size_t i = 0; i < problem.boundaries.size(); ++i) {
+    const Boundary& bc = problem.boundaries[i];
+    if (!bc.friction) continue;
+    const std::string w = "boundaries/" + std::to_string(i) + "/friction";
+    int prescribed = 0;
+    for (int a = 0; a < dim; ++a) prescribed += bc.velocity[a] ? 1 : 0;
+    if (dim == 1)
+      add(w, "needs a 2D or 3D problem: in 1D there is no tangential direction");
+    else if (prescribed != 1)
+      add(w,
+          "needs exactly one prescribed velocity component (the wall normal) and the others "
+          "null (free); this boundary prescribes " +
+              std::to_string(prescribed));
+    if (!(*bc.friction >= 0)) add(w, "must be >= 0");
+  }
   if (!(problem.time.end > 0)) add("time/end", "must be > 0");
   if (!(problem.time.courant > 0 && problem.time.courant <= 1)) add("time/courant", "must be in (0, 1]");
   if (problem.time.dt && !(*problem.time.dt > 0)) add("time/dt", "must be > 0");

@@ -67,6 +67,21 @@ class Simulation {
   RunResult run(const RunOptions& options);
 
  private:
+  struct VelocityConstraint {
+    std::vector<std::int64_t> nodes;
+    std::array<bool, 3> fixed{false, false, false};
+    std::array<const FieldOfTime*, 3> fn{nullptr, nullptr, nullptr};
+    int normal = 0;  ///< the prescribed axis (used with friction)
+    /// Side of the material for friction: +1 when the wall is the grid's min
+    /// face along `normal` (material at larger coordinates), -1 for the max
+    /// face, 0 for a wall inside the grid (either side).
+    int inward = 0;
+    double friction = 0;  ///< Coulomb coefficient mu; inf = no slip
+    /// Per node: tangential velocity cancelled by friction this step.
+    /// Empty when the boundary has no friction.
+    std::vector<std::uint8_t> stuck;
+  };
+
   // ------------------------------------------------------------ set-up
   void setup_grid() {
     for (int a = 0; a < Dim; ++a) {
@@ -90,6 +105,7 @@ class Simulation {
       inv_ks_.push_back(std::isinf(h.solid_bulk_modulus) ? 0.0 : 1.0 / h.solid_bulk_modulus);
       inv_kf_.push_back(1.0 / h.fluid_bulk_modulus);
       fluid_ = fluid_ || m.hydraulic.has_value();
+      plastic_ = plastic_ || constants_.back().model != Model::linear_elastic;
     }
     for (int a = 0; a < Dim; ++a) gravity_[a] = problem_.gravity[a];
   }
@@ -152,7 +168,16 @@ class Simulation {
           if (b.velocity[a]) {
             vc.fixed[a] = true;
             vc.fn[a] = &*b.velocity[a];
+            vc.normal = a;  // unique when friction is given (check_problem)
           }
+        if (b.friction) {
+          vc.friction = *b.friction;
+          vc.stuck.assign(vc.nodes.size(), 0);
+          const int n = vc.normal;
+          const double tol = 1e-9 * grid_.h[n];
+          if (!b.nodes.all && b.nodes.box.max[n] <= grid_.origin[n] + tol) vc.inward = 1;
+          if (!b.nodes.all && b.nodes.box.min[n] >= grid_max_[n] - tol) vc.inward = -1;
+        }
         velocity_bcs_.push_back(std::move(vc));
       }
       if (b.rigid[0] || b.rigid[1] || b.rigid[2]) rigid_ties_.push_back({nodes, b.rigid});
@@ -276,7 +301,10 @@ class Simulation {
     compute_remapped_nodal_velocity(t + dt);
     if (fluid_) {
       for_particles(kFlux, [&](const Scatter& out, std::size_t b, std::size_t e) {
-        update_particle_stress_and_fluid_flux</*Move=*/false>(out, b, e, dt);
+        if (plastic_)
+          update_particle_stress_and_fluid_flux</*Move=*/false, /*Plastic=*/true>(out, b, e, dt);
+        else
+          update_particle_stress_and_fluid_flux</*Move=*/false, /*Plastic=*/false>(out, b, e, dt);
       });
       update_nodal_pressure(t + dt, dt);
       for_particles(0u, [&](const Scatter&, std::size_t b, std::size_t e) {
@@ -284,7 +312,10 @@ class Simulation {
       });
     } else {
       for_particles(0u, [&](const Scatter& out, std::size_t b, std::size_t e) {
-        update_particle_stress_and_fluid_flux</*Move=*/true>(out, b, e, dt);
+        if (plastic_)
+          update_particle_stress_and_fluid_flux</*Move=*/true, /*Plastic=*/true>(out, b, e, dt);
+        else
+          update_particle_stress_and_fluid_flux</*Move=*/true, /*Plastic=*/false>(out, b, e, dt);
       });
     }
   }
@@ -509,6 +540,10 @@ class Simulation {
           grid_.accel[i][a] = (v - grid_.momentum[i][a] / grid_.mass[i]) / dt;
         }
       }
+    // Friction first, from the trial velocity, so that components prescribed
+    // by any boundary (a symmetry plane meeting a floor) win afterwards.
+    for (VelocityConstraint& bc : velocity_bcs_)
+      if (!bc.stuck.empty()) apply_friction(bc, t, dt);
     for (const VelocityConstraint& bc : velocity_bcs_) {
       for (int a = 0; a < Dim; ++a) {
         if (!bc.fixed[a]) continue;
@@ -517,6 +552,12 @@ class Simulation {
           grid_.velocity[i][a] = v_new;
           grid_.accel[i][a] = (v_new - v_old) / dt;
         }
+        // A friction wall gives its nodes' particles the full normal change
+        // (see apply_friction), so the normal impulse is counted once.
+        if (!bc.stuck.empty() && a == bc.normal)
+          for (std::int64_t i : bc.nodes)
+            if (grid_.mass[i] > mass_tolerance_)
+              grid_.accel[i][a] = (v_new - grid_.momentum[i][a] / grid_.mass[i]) / dt;
       }
     }
   }
@@ -550,6 +591,45 @@ class Simulation {
     }
   }
 
+  /// Coulomb friction at the nodes of a boundary whose normal component
+  /// (axis bc.normal) is prescribed and whose other components are free.
+  /// The wall's normal impulse per unit mass is the normal velocity change
+  /// it imposes on the node's trial velocity, dv_n = v_n(t + dt) - v_n^L.
+  /// (For these boundaries the particles then receive that full change, see
+  /// update_nodal_momentum, so particle velocities the wall has stopped are
+  /// not mapped back and counted again the next step.) Friction takes at
+  /// most mu |dv_n| off the tangential velocity (only the compressive part
+  /// at a grid face, where the material's side is known), relative to a
+  /// wall at rest tangentially, and never reverses it. A node whose
+  /// tangential velocity is cancelled sticks (it also keeps zero tangential
+  /// velocity in the re-mapped field). mu = inf: no slip. The normal
+  /// component itself is set by the caller's loop.
+  void apply_friction(VelocityConstraint& bc, double t, double dt) {
+    const int n = bc.normal;
+    const double vn_new = (*bc.fn[n])(t + dt);
+    for (std::size_t k = 0; k < bc.nodes.size(); ++k) {
+      const std::int64_t i = bc.nodes[k];
+      const double m = grid_.mass[i];
+      bc.stuck[k] = 0;
+      if (m <= mass_tolerance_) continue;
+      Vec& v = grid_.velocity[i];
+      Vec vt = v;
+      vt[n] = 0.0;
+      const double slip = vt.norm();
+      const double impulse = vn_new - v[n];
+      const double dvn = bc.inward == 0 ? std::abs(impulse) : std::max(bc.inward * impulse, 0.0);
+      const bool stick = slip <= 0.0 || std::isinf(bc.friction) || bc.friction * dvn >= slip;
+      const double keep = stick ? 0.0 : 1.0 - bc.friction * dvn / slip;
+      const Vec v_start = grid_.momentum[i] / m;
+      for (int a = 0; a < Dim; ++a) {
+        if (a == n) continue;
+        v[a] *= keep;
+        grid_.accel[i][a] = (v[a] - v_start[a]) / dt;
+      }
+      bc.stuck[k] = stick ? 1 : 0;
+    }
+  }
+
   void compute_remapped_nodal_velocity(double t_new) {
     for (RigidTie& tie : rigid_ties_)
       for (int a = 0; a < Dim; ++a) {
@@ -572,6 +652,11 @@ class Simulation {
           if (grid_.mass[i] > mass_tolerance_) grid_.remap[i][a] = tie.remapped[a];
       }
     for (const VelocityConstraint& bc : velocity_bcs_)
+      for (std::size_t k = 0; k < bc.stuck.size(); ++k)
+        if (bc.stuck[k])
+          for (int a = 0; a < Dim; ++a)
+            if (a != bc.normal) grid_.remap[bc.nodes[k]][a] = 0.0;
+    for (const VelocityConstraint& bc : velocity_bcs_)
       for (int a = 0; a < Dim; ++a) {
         if (!bc.fixed[a]) continue;
         const double v = (*bc.fn[a])(t_new);
@@ -584,7 +669,7 @@ class Simulation {
   /// -N V div v + V grad N . w, is scattered to the nodes. When Move, the
   /// particles also move with the Lagrangian nodal velocity (dry runs; in
   /// saturated runs the last phase moves them).
-  template <bool Move>
+  template <bool Move, bool Plastic>
   void update_particle_stress_and_fluid_flux(const Scatter& out, std::size_t begin, std::size_t end,
                                              double dt) {
     StencilT s;
@@ -615,6 +700,7 @@ class Simulation {
       if constexpr (Dim >= 2) rotate_jaumann<Dim>(sig, grad_v, dt);
       for (int c = 0; c < 3; ++c) sig[c] += mc.lambda * tr + 2.0 * mc.shear_modulus * de[c];
       for (int c = 3; c < 6; ++c) sig[c] += 2.0 * mc.shear_modulus * de[c];
+      if constexpr (Plastic) return_to_yield_surface(sig, mc);
       particles_.strain[p] += de;
       const double j = (Mat::Identity() + dt * grad_v).determinant();
       if (!(j > 0.0)) fail_volume(p, j);
@@ -670,6 +756,22 @@ class Simulation {
       if (particles_.x[p][a] < grid_.origin[a] || particles_.x[p][a] > grid_max_[a]) fail_left_grid(p);
   }
 
+  /// Plastic correction of the elastic trial stress (effective stress, so
+  /// dry and saturated alike): closed-form return mapping of the material's
+  /// model; linear-elastic materials in a run with plastic ones pass through.
+  static inline void return_to_yield_surface(Voigt& sig, const MaterialConstants& mc) {
+    switch (mc.model) {
+      case Model::mohr_coulomb:
+        constitutive::return_mohr_coulomb(sig, mc.elastic, mc.mohr_coulomb);
+        break;
+      case Model::drucker_prager:
+        constitutive::return_drucker_prager(sig, mc.elastic, mc.drucker_prager);
+        break;
+      case Model::linear_elastic:
+        break;
+    }
+  }
+
   // ------------------------------------------------------------ failures
   // Called from hot loops only on the failure path. Threads may find
   // failures in any order; the lowest particle index wins, so the report is
@@ -714,11 +816,6 @@ class Simulation {
   void fill_snapshot(Snapshot& snap, const std::vector<Field>& fields) const;
   void sample_series(Series& series, double t) const;
 
-  struct VelocityConstraint {
-    std::vector<std::int64_t> nodes;
-    std::array<bool, 3> fixed{false, false, false};
-    std::array<const FieldOfTime*, 3> fn{nullptr, nullptr, nullptr};
-  };
   /// Nodes sharing one velocity component per marked axis (rigid plate).
   struct RigidTie {
     std::vector<std::int64_t> nodes;
@@ -750,6 +847,7 @@ class Simulation {
   Vec gravity_ = Vec::Zero();
   Vec grid_max_ = Vec::Zero();
   bool fluid_ = false;
+  bool plastic_ = false;        ///< any material with a return mapping
   double darcy_inertia_ = 1.0;  ///< weight of rho_f a in Darcy's law (1: as in the paper)
   double mass_tolerance_ = 0.0;
   StableStep stable_;

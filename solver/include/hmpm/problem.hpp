@@ -126,6 +126,13 @@ struct Boundary {
   /// velocity component (Mandel's plates). A velocity prescribed on the same
   /// axis by any boundary wins.
   std::array<bool, 3> rigid{false, false, false};
+  /// Coulomb friction of a wall: needs exactly one prescribed velocity
+  /// component (the wall normal), the others free. Each step the tangential
+  /// nodal velocity loses at most friction * |normal velocity change imposed
+  /// by the wall| and is never reversed (a wall at rest tangentially).
+  /// +infinity: no slip ("rough"). std::nullopt: no friction (free
+  /// components untouched).
+  std::optional<double> friction;
 };
 
 /// Surface load on one face of the particles inside `particles`.
