@@ -44,7 +44,8 @@ constexpr std::string_view kBody[] = {"material", "box", "particles_per_cell", "
 constexpr std::string_view kBodyRequired[] = {"material", "box"};
 constexpr std::string_view kBox[] = {"min", "max"};
 constexpr std::string_view kInitial[] = {"velocity", "pore_pressure", "effective_stress"};
-constexpr std::string_view kBoundary[] = {"nodes", "velocity", "pore_pressure", "rigid"};
+constexpr std::string_view kBoundary[] = {"nodes", "velocity", "pore_pressure", "rigid",
+                                          "friction"};
 constexpr std::string_view kBoundaryRequired[] = {"nodes"};
 constexpr std::string_view kSelection[] = {"box"};
 constexpr std::string_view kTraction[] = {"particles", "face", "traction"};
@@ -589,6 +590,24 @@ void JobParser::parse_boundary(const json& j, const std::string& path) {
                            " prescribes that component; a rigid tie needs it free");
       }
     }
+  }
+  if (j.contains("friction")) {
+    // A Coulomb coefficient, or "rough" for no slip; which component is the
+    // wall normal (exactly one prescribed) is checked by check_problem.
+    const json& f = j["friction"];
+    const std::string fp = path + "/friction";
+    if (f.is_string()) {
+      if (f.get<std::string>() == "rough")
+        b.friction = std::numeric_limits<double>::infinity();
+      else
+        r_.error(fp, "expected a number >= 0 (Coulomb coefficient) or \"rough\" (no slip), got \"" +
+                         f.get<std::string>() + "\"");
+    } else if (auto mu = r_.number(f, fp, Range::non_negative())) {
+      b.friction = *mu;
+    }
+    if (!j.contains("velocity"))
+      r_.error(fp,
+               "needs 'velocity' with the wall-normal component prescribed and the others null");
   }
   if (j.contains("pore_pressure")) {
     b.pore_pressure = time_value(j["pore_pressure"], path + "/pore_pressure");

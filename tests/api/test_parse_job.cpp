@@ -290,5 +290,40 @@ TEST(ParseJob, RigidBoundaryAxes) {
   EXPECT_FALSE(b.pore_pressure.has_value());
 }
 
+TEST(ParseJob, FrictionOfAWall) {
+  json spec = json::parse(read_text(source_path("tests/api/data/valid-2d.json")));
+  spec["boundaries"].push_back(json::parse(
+      R"({"nodes": {"box": {"min": [0, 0], "max": [1, 0]}}, "velocity": [null, 0], "friction": 0.5})"));
+  spec["boundaries"].push_back(json::parse(
+      R"({"nodes": {"box": {"min": [0, 0], "max": [1, 0]}}, "velocity": [null, 0], "friction": "rough"})"));
+  const ParsedJob job = parse_valid(spec.dump());
+  const auto& bs = job.problem.boundaries;
+  ASSERT_GE(bs.size(), 2u);
+  EXPECT_EQ(bs[bs.size() - 2].friction, 0.5);
+  EXPECT_TRUE(std::isinf(*bs.back().friction));
+}
+
+TEST(ParseJob, FrictionNeedsExactlyOneNormalComponent) {
+  const auto errors_of = [](const std::string& boundary) {
+    json spec = json::parse(read_text(source_path("tests/api/data/valid-2d.json")));
+    spec["boundaries"] = json::array({json::parse(boundary)});
+    return parse_job(spec.dump()).errors;
+  };
+  const auto has = [](const std::vector<SpecError>& errors, const std::string& path,
+                      const std::string& words) {
+    for (const SpecError& e : errors)
+      if (e.path == path && e.message.find(words) != std::string::npos) return true;
+    return false;
+  };
+  EXPECT_TRUE(has(errors_of(R"({"nodes": "all", "velocity": [0, 0], "friction": 0.3})"),
+                  "/boundaries/0/friction", "exactly one prescribed velocity component"));
+  EXPECT_TRUE(has(errors_of(R"({"nodes": "all", "pore_pressure": 0, "friction": 0.3})"),
+                  "/boundaries/0/friction", "needs 'velocity'"));
+  EXPECT_TRUE(has(errors_of(R"({"nodes": "all", "velocity": [null, 0], "friction": -1})"),
+                  "/boundaries/0/friction", ">= 0"));
+  EXPECT_TRUE(has(errors_of(R"({"nodes": "all", "velocity": [null, 0], "friction": "sticky"})"),
+                  "/boundaries/0/friction", "\"rough\""));
+}
+
 }  // namespace
 }  // namespace hmpm::api
