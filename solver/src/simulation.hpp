@@ -527,17 +527,23 @@ class Simulation {
     for (const RigidTie& tie : rigid_ties_)
       for (int a = 0; a < Dim; ++a) {
         if (!tie.axes[a]) continue;
-        double mass = 0.0, momentum = 0.0;
+        // The plate's velocity and acceleration: summed momenta and forces
+        // (after damping) over summed masses. Every tied node takes both, so
+        // particles see the rigid-body acceleration, not the jump that
+        // projecting each node's own start velocity onto the plate's would
+        // add (that jump, divided by dt, would also enter Darcy's rho_f a).
+        double mass = 0.0, momentum = 0.0, momentum0 = 0.0;
         for (std::int64_t i : tie.nodes) {
           mass += grid_.mass[i];
           momentum += grid_.mass[i] * grid_.velocity[i][a];
+          momentum0 += grid_.momentum[i][a];
         }
         if (!(mass > 0.0)) continue;
-        const double v = momentum / mass;
+        const double v = momentum / mass, accel = (momentum - momentum0) / (mass * dt);
         for (std::int64_t i : tie.nodes) {
           if (grid_.mass[i] <= mass_tolerance_) continue;
           grid_.velocity[i][a] = v;
-          grid_.accel[i][a] = (v - grid_.momentum[i][a] / grid_.mass[i]) / dt;
+          grid_.accel[i][a] = accel;
         }
       }
     // Friction first, from the trial velocity, so that components prescribed

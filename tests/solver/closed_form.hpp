@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cmath>
+#include <vector>
 
 namespace closed_form {
 
@@ -48,5 +49,52 @@ inline double terzaghi_degree(double tv, int terms = 400) {
   }
   return 1 - s;
 }
+
+}  // namespace closed_form
+
+namespace closed_form {
+
+/// Mandel's problem (§4; Mandel 1953, Abousleiman et al. 1996): plane-strain
+/// specimen |x| <= a between rigid smooth impermeable plates carrying 2F,
+/// lateral faces drained. With the drained and undrained Poisson ratios nu,
+/// nu_u, the consolidation coefficient c and the initial (undrained)
+/// pressure p0 = F B (1 + nu_u) / (3a):
+///   p(x,t) = 2 p0 sum_n sin(a_n) / (a_n - sin(a_n) cos(a_n))
+///                      (cos(a_n x/a) - cos(a_n)) exp(-a_n^2 c t / a^2),
+/// a_n the positive roots of tan(a) = (1 - nu)/(nu_u - nu) a, one in each
+/// ((n-1) pi, (n-1) pi + pi/2).
+struct Mandel {
+  double nu, nu_u, a, c, p0;
+  std::vector<double> roots;
+
+  Mandel(double nu_, double nu_u_, double a_, double c_, double p0_, int terms = 400)
+      : nu(nu_), nu_u(nu_u_), a(a_), c(c_), p0(p0_) {
+    const double k = (1 - nu) / (nu_u - nu);
+    // f = sin - k a cos changes sign once on each bracket; bisection to round-off.
+    auto f = [k](double x) { return std::sin(x) - k * x * std::cos(x); };
+    for (int n = 1; n <= terms; ++n) {
+      double lo = (n - 1) * pi + 1e-9, hi = (n - 1) * pi + pi / 2 - 1e-12;
+      const bool lo_negative = f(lo) < 0;
+      for (int it = 0; it < 200 && hi - lo > 1e-15 * hi; ++it) {
+        const double mid = 0.5 * (lo + hi);
+        if ((f(mid) < 0) == lo_negative)
+          lo = mid;
+        else
+          hi = mid;
+      }
+      roots.push_back(0.5 * (lo + hi));
+    }
+  }
+
+  double pressure(double x, double t) const {
+    double s = 0;
+    for (double r : roots) {
+      const double e = std::exp(-r * r * c * t / (a * a));
+      if (e < 1e-300) break;
+      s += std::sin(r) / (r - std::sin(r) * std::cos(r)) * (std::cos(r * x / a) - std::cos(r)) * e;
+    }
+    return 2 * p0 * s;
+  }
+};
 
 }  // namespace closed_form
