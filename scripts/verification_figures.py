@@ -61,6 +61,35 @@ def terzaghi_exact(z, tv, H, q, terms=400):
     return p
 
 
+def mandel_roots(nu, nu_u, terms=400):
+    """Positive roots of tan(a) = (1 - nu)/(nu_u - nu) a, one per ((n-1) pi, (n-1) pi + pi/2)."""
+    k = (1 - nu) / (nu_u - nu)
+    roots = []
+    for n in range(1, terms + 1):
+        lo, hi = (n - 1) * math.pi + 1e-9, (n - 1) * math.pi + math.pi / 2 - 1e-12
+        f = lambda x: math.sin(x) - k * x * math.cos(x)  # noqa: E731
+        lo_negative = f(lo) < 0
+        for _ in range(200):
+            mid = 0.5 * (lo + hi)
+            if (f(mid) < 0) == lo_negative:
+                lo = mid
+            else:
+                hi = mid
+        roots.append(0.5 * (lo + hi))
+    return roots
+
+
+def mandel_exact(x, T, a, p0, roots):
+    """Mandel (1953), Abousleiman et al. (1996): pore pressure at x, T = c t / a^2."""
+    s = 0.0
+    for r in roots:
+        e = math.exp(-r * r * T)
+        if e < 1e-300:
+            break
+        s += math.sin(r) / (r - math.sin(r) * math.cos(r)) * (math.cos(r * x / a) - math.cos(r)) * e
+    return 2 * p0 * s
+
+
 # ------------------------------------------------------------ figures
 def bar_figure(spec, series, out):
     mat = next(iter(spec["materials"].values()))
@@ -174,6 +203,64 @@ def terzaghi_figure(spec, series, out, snapshots_dir=None):
              f"{100 * worst:.2f} %", "1 %")]
 
 
+def mandel_figure(spec, series, out):
+    mat = next(iter(spec["materials"].values()))
+    h = mat["hydraulic"]
+    E, nu, n = mat["youngs_modulus"], mat["poisson_ratio"], h["porosity"]
+    a = spec["bodies"][0]["box"]["max"][0]
+    q = -spec["tractions"][0]["traction"][1]
+    G = E / (2 * (1 + nu))
+    K = E / (3 * (1 - 2 * nu))
+    M = h["fluid_bulk_modulus"] / n  # incompressible grains: Biot modulus Kf/n
+    E_oed = K + 4 * G / 3
+    B = M / (K + M)
+    nu_u = (3 * (K + M) - 2 * G) / (2 * (3 * (K + M) + G))
+    c = h["hydraulic_conductivity"] / GAMMA_W / (1 / M + 1 / E_oed)
+    p0 = q * B * (1 + nu_u) / 3
+    roots = mandel_roots(nu, nu_u)
+    T = [ti * c / a ** 2 for ti in series["time"]]
+    fig, axes = plt.subplots(1, 2, figsize=(11, 4))
+    ax = axes[0]
+    worst_centre, peak = 0.0, 0.0
+    for k, p in enumerate(series["particles"][:1] + series["particles"][3::3]):
+        x = p["initial_position"][0]
+        pe = [mandel_exact(x, v, a, p0, roots) if v > 0 else p0 for v in T]
+        pp = p["pore_pressure"]
+        if k == 0:
+            worst_centre = max(abs(u - w) for u, w in zip(pp, pe)) / p0
+            peak = max(pp) / p0
+        line, = ax.plot(T, [u / p0 for u in pp], "o", ms=2, label=f"x = {x / a:.3f} a")
+        fine = [0.0005 * i for i in range(1, 1001)]
+        ax.plot(fine, [mandel_exact(x, v, a, p0, roots) / p0 for v in fine], "-", color=line.get_color(), lw=1)
+    ax.axhline(1.0, color="k", lw=0.5)
+    ax.set_xlabel("T = c t / a^2")
+    ax.set_ylabel("p / p0")
+    ax.set_title("Mandel: pore pressure, hmpm (dots) vs closed form (lines)", fontsize=9)
+    ax.legend(fontsize=8)
+    ax = axes[1]
+    xs = [p["initial_position"][0] for p in series["particles"]]
+    for target in (0.01, 0.05, 0.1, 0.2, 0.5):
+        row = min(range(len(T)), key=lambda i: abs(T[i] - target))
+        line, = ax.plot([x / a for x in xs], [p["pore_pressure"][row] / p0 for p in series["particles"]], "o", ms=3,
+                        label=f"T = {T[row]:.2f}")
+        fine = [i / 100 * a for i in range(101)]
+        ax.plot([x / a for x in fine], [mandel_exact(x, T[row], a, p0, roots) / p0 for x in fine], "-",
+                color=line.get_color(), lw=1)
+    ax.set_xlabel("x / a")
+    ax.set_ylabel("p / p0")
+    ax.set_title("Mandel: profiles across the specimen", fontsize=9)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(out / "mandel.png", dpi=110)
+    plt.close(fig)
+    fine = [0.0005 * i for i in range(1, 1001)]
+    peak_exact = max(mandel_exact(xs[0], v, a, p0, roots) for v in fine) / p0
+    return [("Mandel (verification 4)", "max |p - p_exact| / p0 at the centre particle, T in [0, 0.5]",
+             f"{100 * worst_centre:.2f} %", "3 %"),
+            ("Mandel (verification 4)", "Mandel-Cryer peak at the centre, p / p0 (closed form)",
+             f"{peak:.4f} ({peak_exact:.4f})", "3 % of p0")]
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--hmpm", default=str(REPO / "build" / "bin" / "hmpm"))
@@ -186,6 +273,7 @@ def main():
         rows += bar_figure(*run_example(args.hmpm, "bar-vibration", work), out)
         rows += darcy_figures(*run_example(args.hmpm, "darcy-flow", work), out)
         rows += terzaghi_figure(*run_example(args.hmpm, "terzaghi", work), out)
+        rows += mandel_figure(*run_example(args.hmpm, "mandel", work), out)
     print("| problem | measure | hmpm | bound |")
     print("|---|---|---|---|")
     for r in rows:
