@@ -261,6 +261,151 @@ def mandel_figure(spec, series, out):
              f"{peak:.4f} ({peak_exact:.4f})", "3 % of p0")]
 
 
+# ------------------------------------------------------------ column collapse
+def lube_2005(a):
+    """Lube et al. (2005), quasi-2D, interpolated linearly for 1.8 < a < 2.8."""
+    if a <= 1.8:
+        return 1.2 * a
+    if a >= 2.8:
+        return 1.9 * a ** (2 / 3)
+    lo, hi = 1.2 * 1.8, 1.9 * 2.8 ** (2 / 3)
+    return lo + (a - 1.8) / (2.8 - 1.8) * (hi - lo)
+
+
+def collapse_spec(base, a, dim, across):
+    """The set-up of examples/column-collapse.json (and of
+    tests/solver/test_collapse.cpp) for aspect ratio a: 2D with `across`
+    cells across min(H0, L0), or the 3D quarter cylinder (staircase of
+    whole cells, z up) with `across` cells across R0. Returns the spec, H0,
+    L0 (or the equivalent radius R0) and the cell size."""
+    h, rho, g = 0.01, 1800.0, 9.81
+    spec = json.loads(json.dumps(base))
+    mat = spec["materials"]["sand"]
+    if dim == 2:
+        n_l = across if a >= 1 else round(across / a)
+        n_h = round(n_l * a)
+        expected = lube_2005(a)
+        nx = math.ceil(n_l * (1 + 3 * expected)) + 4
+        cells = [nx, n_h + 3]
+        up, boxes = 1, [([0, 0], [n_l * h, n_h * h])]
+        l0 = n_l * h
+    else:
+        n_h = round(across * a)
+        expected = 1.24 * a
+        nxy = math.ceil(across * (1 + 2 * expected)) + 4
+        cells = [nxy, nxy, n_h + 3]
+        up, boxes, count = 2, [], 0
+        for j in range(across):
+            row = 0
+            while (row + 0.5) ** 2 + (j + 0.5) ** 2 <= across ** 2:
+                row += 1
+            if row:
+                count += row
+                boxes.append(([0, j * h, 0], [row * h, (j + 1) * h, n_h * h]))
+        l0 = math.sqrt(4 * count * h * h / math.pi)
+    h0 = n_h * h
+    mat["youngs_modulus"] = rho * g * h0 / 1e-3
+    spec["dimension"] = dim
+    spec["grid"] = {"min": [0.0] * dim, "max": [c * h for c in cells], "cells": cells}
+    axis = "xyz"[up]
+    sv = f"-{rho}*{g}*({h0}-{axis})"
+    stress = [f"-0.5*{rho}*{g}*({h0}-{axis})"] * 3 + [0, 0, 0]
+    stress[up] = sv
+    spec["bodies"] = [{"material": "sand", "box": {"min": lo, "max": hi}, "particles_per_cell": 2,
+                       "initial": {"effective_stress": stress}} for lo, hi in boxes]
+    spec["gravity"] = [0.0] * dim
+    spec["gravity"][up] = -g
+    spec["boundaries"] = []
+    for ax in range(dim):
+        lo, hi = [0.0] * dim, [c * h for c in cells]
+        hi[ax] = 0.0
+        v = [None] * dim
+        v[ax] = 0.0
+        b = {"nodes": {"box": {"min": lo, "max": hi}}, "velocity": v}
+        if ax == up:
+            b["friction"] = "rough"
+        spec["boundaries"].append(b)
+    # At rest by then in every case (tests: at most 5.4 sqrt(H0/g) in 2D, 7 in 3D).
+    spec["time"] = {"end": (8 if dim == 2 else 10) * math.sqrt(h0 / g)}
+    spec["output"] = {"snapshots": {"interval": spec["time"]["end"], "fields": ["displacement"]}}
+    return spec, h0, l0, h
+
+
+def deposit_front(points, dim, h, h0):
+    """The front of the deposit as in tests/solver/test_collapse.cpp: the end
+    of the contiguous bins of width h from the wall (radial bins in 3D)
+    whose thickness (particle volume / plan area) is >= 2 % of H0, plus half
+    a particle spacing (2 particles per cell)."""
+    import numpy as np
+    dp = h / 2
+    r = points[:, 0] if dim == 2 else np.hypot(points[:, 0], points[:, 1])
+    bins = (r / h).astype(int)
+    volume = np.bincount(bins) * dp ** dim
+    i = np.arange(len(volume))
+    area = h * np.ones_like(volume) if dim == 2 else 0.25 * math.pi * ((i + 1) ** 2 - i ** 2) * h * h
+    end = 0
+    while end < len(volume) and volume[end] / area[end] >= 0.02 * h0:
+        end += 1
+    return r[r < end * h].max() + dp / 2
+
+
+def collapse_figure(hmpm, work, out):
+    import meshio
+    base = json.loads((REPO / "examples" / "column-collapse.json").read_text())
+    cases = [(a, 2, 10) for a in (0.5, 1, 2, 5)] + [(1.0, 3, 8)]
+    results = []
+    for a, dim, across in cases:
+        spec, h0, l0, h = collapse_spec(base, a, dim, across)
+        name = f"collapse-{dim}d-{a}"
+        path = pathlib.Path(work) / f"{name}.json"
+        path.write_text(json.dumps(spec))
+        subprocess.run([str(hmpm), "run", str(path), "--out", str(pathlib.Path(work) / name)],
+                       check=True, capture_output=True)
+        last = sorted((pathlib.Path(work) / name).glob("snapshot_*.vtu"))[-1]
+        pts = meshio.read(last).points
+        front = deposit_front(pts, dim, h, h0)
+        results.append((a, dim, across, (front - l0) / l0, pts / l0, front / l0))
+    fig = plt.figure(figsize=(12, 5.5))
+    grid = fig.add_gridspec(4, 2, width_ratios=[1.6, 1])
+    ax2 = fig.add_subplot(grid[:, 1])
+    panels = [r for r in results if r[1] == 2]
+    for k, (a, dim, _, r, pts, front) in enumerate(panels):
+        ax1 = fig.add_subplot(grid[k, 0])
+        ax1.plot(pts[:, 0], pts[:, 1], ".", ms=1.0, color="tab:brown")
+        ax1.axvline(front, color="k", lw=0.8, ls="--")
+        ax1.axvline(1 + lube_2005(a), color="tab:blue", lw=0.8)
+        ax1.set_xlim(0, 1.35 * (1 + lube_2005(a)))
+        ax1.set_ylabel(f"a = {a:g}\ny / L0", fontsize=8)
+        ax1.tick_params(labelsize=7)
+        if k == 0:
+            ax1.set_title("2D deposits at rest: front measured (dashed), Lube 2005 (blue)", fontsize=9)
+        if k == len(panels) - 1:
+            ax1.set_xlabel("x / L0")
+    aa = [0.3 + 0.05 * i for i in range(100)]
+    ax2.plot([x for x in aa if x <= 1.8], [1.2 * x for x in aa if x <= 1.8], "k-", lw=1,
+             label="Lube 2005: 1.2 a, 1.9 a^(2/3)")
+    ax2.plot([x for x in aa if x >= 2.8], [1.9 * x ** (2 / 3) for x in aa if x >= 2.8], "k-", lw=1)
+    ax2.plot([1.8, 2.8], [lube_2005(1.8), lube_2005(2.8)], "k:", lw=1, label="interpolated")
+    ax2.plot([0.3, 1.7], [1.24 * 0.3, 1.24 * 1.7], "b--", lw=1, label="Lube 2004 (axisymmetric): 1.24 a")
+    for a, dim, _, r, *_ in results:
+        ax2.plot([a], [r], "ko" if dim == 2 else "bs", ms=5)
+    ax2.set_xlabel("aspect ratio a = H0 / L0")
+    ax2.set_ylabel("(L_inf - L0) / L0")
+    ax2.set_title("runout: hmpm (2D dots, 3D square) vs Lube")
+    ax2.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(out / "column-collapse.png", dpi=110)
+    plt.close(fig)
+    rows = []
+    for a, dim, across, r, *_ in results:
+        ref = lube_2005(a) if dim == 2 else 1.24 * a
+        law = "Lube 2005" if dim == 2 else "Lube 2004, 3D quarter"
+        bound = "15 %" if dim == 2 else "25 %"
+        rows.append((f"Column collapse a = {a:g} ({law}, {across} cells)",
+                     f"(L_inf - L0)/L0 vs {ref:.3f}", f"{r:.3f} ({100 * (r / ref - 1):+.1f} %)", bound))
+    return rows
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--hmpm", default=str(REPO / "build" / "bin" / "hmpm"))
@@ -274,6 +419,7 @@ def main():
         rows += darcy_figures(*run_example(args.hmpm, "darcy-flow", work), out)
         rows += terzaghi_figure(*run_example(args.hmpm, "terzaghi", work), out)
         rows += mandel_figure(*run_example(args.hmpm, "mandel", work), out)
+        rows += collapse_figure(args.hmpm, work, out)
     print("| problem | measure | hmpm | bound |")
     print("|---|---|---|---|")
     for r in rows:
