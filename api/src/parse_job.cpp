@@ -181,6 +181,7 @@ class JobParser {
   std::vector<PendingNear> near_;
   std::vector<PositionFormula> position_formulas_;
   std::vector<TimeFormula> time_formulas_;
+  bool damping_formula_ = false;  // local_damping given as a formula of t
   std::vector<std::string> traction_paths_;
   bool any_pore_pressure_bc_ = false;
   std::string first_pore_pressure_bc_;
@@ -243,9 +244,18 @@ void JobParser::parse_root(const json& root) {
   if (root.contains("gravity_constant"))
     if (auto g = r_.number(root["gravity_constant"], "/gravity_constant", Range::positive()))
       p_.gravity_constant = *g;
-  if (root.contains("local_damping"))
-    if (auto d = r_.number(root["local_damping"], "/local_damping", {0.0, 1.0, false, true}))
-      p_.local_damping = *d;
+  if (root.contains("local_damping")) {
+    // A number is checked here; a formula of t is checked each step by the
+    // solver (a value outside [0, 1) fails the run at that step).
+    const json& d = root["local_damping"];
+    if (d.is_number()) {
+      if (auto v = r_.number(d, "/local_damping", {0.0, 1.0, false, true}))
+        p_.local_damping = constant_field_of_time(*v);
+    } else if (auto f = time_value(d, "/local_damping")) {
+      p_.local_damping = *f;
+      damping_formula_ = true;
+    }
+  }
   if (root.contains("boundaries")) {
     const json& b = root["boundaries"];
     if (r_.array(b, "/boundaries"))
@@ -885,6 +895,11 @@ void JobParser::check_formulas_are_finite() {
       if (!std::isfinite(v)) {
         r_.error(tf.path,
                  "the formula gives " + format_number(v) + " at t = " + format_number(t) + " s");
+        break;
+      }
+      if (damping_formula_ && tf.path == "/local_damping" && !(v >= 0.0 && v < 1.0)) {
+        r_.error(tf.path, "the formula gives " + format_number(v) + " at t = " +
+                              format_number(t) + " s; local damping must lie in [0, 1)");
         break;
       }
     }

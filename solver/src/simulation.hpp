@@ -293,6 +293,12 @@ class Simulation {
   // ------------------------------------------------------------ the step
   /// Advances the state from t to t + dt. Sets failure_ on the first problem.
   void step(double t, double dt) {
+    damping_ = problem_.local_damping ? problem_.local_damping(t) : 0.0;
+    if (!(damping_ >= 0.0 && damping_ < 1.0)) {  // checked before the step changes anything
+      fail_run("local_damping is " + number(damping_) + " at t = " + number(t) + " s, outside [0, 1)",
+               "keep the local_damping formula between 0 and 1 (exclusive) at all times");
+      return;
+    }
     clear_grid();
     for_particles(kMass | kMomentum | kForce | (fluid_ ? kStorage | kPressure : 0u),
                   [&](const Scatter& out, std::size_t b, std::size_t e) { map_particles_to_grid(out, b, e); });
@@ -517,7 +523,7 @@ class Simulation {
   /// velocities at t + dt. Gives the Lagrangian nodal velocity and the
   /// nodal acceleration used by the particles.
   void update_nodal_momentum(double t, double dt) {
-    const double alpha = problem_.local_damping;
+    const double alpha = damping_;
     for (std::int64_t i = 0; i < grid_.count; ++i) {
       const double m = grid_.mass[i];
       if (m <= mass_tolerance_) {
@@ -794,9 +800,17 @@ class Simulation {
   void record_failure(std::size_t p, std::string what, std::string hint) {
     std::lock_guard<std::mutex> lock(failure_mutex_);
     const auto index = static_cast<std::int64_t>(p);
-    if (failed_ && failure_particle_ <= index) return;
+    if (failed_ && failure_particle_ <= index) return;  // also keeps a fail_run (-1)
     failed_ = true;
     failure_particle_ = index;
+    failure_ = std::move(what);
+    failure_hint_ = std::move(hint);
+  }
+  /// A failure of the whole run, not of a particle (reported without one).
+  void fail_run(std::string what, std::string hint) {
+    std::lock_guard<std::mutex> lock(failure_mutex_);
+    failed_ = true;
+    failure_particle_ = -1;
     failure_ = std::move(what);
     failure_hint_ = std::move(hint);
   }
@@ -871,6 +885,7 @@ class Simulation {
   std::vector<ScatterBuffer> buffers_;
 
   std::mutex failure_mutex_;
+  double damping_ = 0.0;  // local damping coefficient of the current step
   bool failed_ = false;  // written under failure_mutex_, read between phases
   std::int64_t failure_particle_ = -1;
   std::string failure_;

@@ -165,15 +165,16 @@ RunResult Simulation<Dim, Shape>::run(const RunOptions& options) {
     const double t_new = (n + 1 == total) ? end : static_cast<double>(n + 1) * dt;
     step(t, t_new - t);
     if (failed_) {
-      const auto p = static_cast<std::size_t>(failure_particle_);
       std::ostringstream where;
-      where << "(";
-      for (int a = 0; a < Dim; ++a) where << (a ? ", " : "") << number(particles_.x[p][a]);
-      where << ")";
+      if (failure_particle_ >= 0) {  // -1: a failure of the run, not of a particle
+        const auto p = static_cast<std::size_t>(failure_particle_);
+        where << ", particle " << failure_particle_ << " at (";
+        for (int a = 0; a < Dim; ++a) where << (a ? ", " : "") << number(particles_.x[p][a]);
+        where << ")";
+      }
       result.status = RunStatus::failed;
-      result.message = "step " + std::to_string(n + 1) + " (t = " + number(t_new) + " s), particle " +
-                       std::to_string(failure_particle_) + " at " + where.str() + ": " + failure_ +
-                       ". What to change: " + failure_hint_ + ".";
+      result.message = "step " + std::to_string(n + 1) + " (t = " + number(t_new) + " s)" +
+                       where.str() + ": " + failure_ + ". What to change: " + failure_hint_ + ".";
       t = t_new;
       ++n;
       break;

@@ -75,7 +75,7 @@ TEST(ParseJob, RoundTripOfEveryField) {
 
   EXPECT_EQ(p.gravity, (Vec3{0, -9.81, 0}));
   EXPECT_DOUBLE_EQ(p.gravity_constant, 9.81);
-  EXPECT_DOUBLE_EQ(p.local_damping, 0.05);
+  EXPECT_DOUBLE_EQ(p.local_damping(0.0), 0.05);
 
   ASSERT_EQ(p.boundaries.size(), 3u);
   EXPECT_FALSE(p.boundaries[0].nodes.all);
@@ -134,12 +134,23 @@ TEST(ParseJob, DefaultsOfTheContract) {
   EXPECT_DOUBLE_EQ(p.time.courant, 0.5);
   EXPECT_FALSE(p.time.dt.has_value());
   EXPECT_DOUBLE_EQ(p.gravity_constant, 9.81);
-  EXPECT_DOUBLE_EQ(p.local_damping, 0.0);
+  EXPECT_FALSE(p.local_damping);
   EXPECT_TRUE(p.output.series_particles.empty());
   EXPECT_DOUBLE_EQ(p.output.snapshot_interval, 0.0);
   EXPECT_EQ(job.cost.particles, 20);
   EXPECT_EQ(job.cost.snapshots, 0);
   EXPECT_EQ(job.cost.series_rows, 0);
+}
+
+TEST(ParseJob, LocalDampingFormulaOfTime) {
+  const ParsedJob job =
+      parse_valid(R"json({"dimension": 1, "grid": {"min": [0], "max": [1], "cells": [10]},
+    "materials": {"m": {"model": "linear_elastic", "density": 1, "youngs_modulus": 1, "poisson_ratio": 0}},
+    "bodies": [{"material": "m", "box": {"min": [0], "max": [1]}}], "local_damping": "t < 0.5 ? 0.2 : 0",
+    "time": {"end": 1}})json");
+  ASSERT_TRUE(job.problem.local_damping);
+  EXPECT_DOUBLE_EQ(job.problem.local_damping(0.25), 0.2);
+  EXPECT_DOUBLE_EQ(job.problem.local_damping(0.75), 0.0);
 }
 
 TEST(ParseJob, ShapeFunctionsModelsAndAllSelections) {

@@ -127,7 +127,7 @@ TEST(GravityColumn, ReachesSelfWeightStress) {
     b.particles_per_cell = 2;
     p.bodies.push_back(b);
     p.gravity = {0, -g, 0};
-    p.local_damping = 0.15;
+    p.local_damping = problems::constant(0.15);
     p.boundaries.push_back(problems::fixed_velocity(problems::plane(p, 0, 0.0), 0));
     p.boundaries.push_back(problems::fixed_velocity(problems::plane(p, 0, W), 0));
     hmpm::Boundary bottom = problems::fixed_velocity(problems::plane(p, 1, 0.0), 1);

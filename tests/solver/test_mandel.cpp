@@ -82,7 +82,7 @@ hmpm::Problem mandel(const MandelCase& c, double end) {
   const double h = c.h(), a = c.a, b = c.b();
   hmpm::Problem p;
   p.dimension = 2;
-  p.local_damping = c.damping;
+  p.local_damping = problems::constant(c.damping);
   // Room to expand laterally and one empty row above the plate.
   p.grid.max = {a + 2 * h, b + h, 0};
   p.grid.cells = {c.cells + 2, c.rows + 1, 1};

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <string>
 
 #include "hmpm/run.hpp"
 
@@ -66,6 +67,43 @@ TEST(StableStep, UserStepAboveLimitIsRefusedWithTheLimit) {
   ASSERT_EQ(issues.size(), 1u);
   EXPECT_EQ(issues[0].where, "time/dt");
   EXPECT_NE(issues[0].message.find("0.02433"), std::string::npos) << issues[0].message;
+}
+
+// A damping schedule (local_damping as a function of t) acts exactly while
+// it is non-zero: a free body falling under g = 1 m/s^2 with alpha = 0.5 for
+// t < 0.5 s and 0 afterwards reaches v = g (0.5 (1 - alpha) + 0.5) = 0.75
+// m/s at t = 1 s (every node carries the same force, so Cundall damping
+// removes alpha |f| from each). Tolerance: the first step of each phase
+// sees the sign of the previous velocity (0 at t = 0), one step of g alpha dt.
+TEST(LocalDamping, ScheduleActsOnlyWhileNonZero) {
+  hmpm::Problem p = bar_problem();
+  p.gravity = {-1.0, 0.0, 0.0};
+  p.grid.min = {-1.0, 0.0, 0.0};  // room to fall 0.4 m
+  p.grid.cells = {26, 1, 1};
+  p.time.dt = 0.01;
+  p.output.snapshot_interval = 1.0;
+  p.output.snapshot_fields = {hmpm::Field::velocity};
+  double v_end = 0.0;
+  hmpm::RunOptions opt;
+  opt.on_snapshot = [&](const hmpm::Snapshot& s) { v_end = s.velocity[0]; };
+  const double alpha = 0.5;
+  p.local_damping = [alpha](double t) { return t < 0.5 ? alpha : 0.0; };
+  const hmpm::RunResult r = hmpm::run(p, opt);
+  ASSERT_EQ(r.status, hmpm::RunStatus::successful) << r.message;
+  EXPECT_NEAR(v_end, -(0.5 * (1 - alpha) + 0.5), alpha * 0.01 + 1e-12);
+}
+
+// A schedule that leaves [0, 1) fails the run at that step, without naming
+// a particle (it is not a particle's failure).
+TEST(LocalDamping, ScheduleOutOfRangeFailsTheRun) {
+  hmpm::Problem p = bar_problem();
+  p.time.dt = 0.01;
+  p.local_damping = [](double t) { return t < 0.5 ? 0.1 : 1.0; };
+  const hmpm::RunResult r = hmpm::run(p);
+  ASSERT_EQ(r.status, hmpm::RunStatus::failed);
+  EXPECT_NE(r.message.find("local_damping is 1 at t = 0.5"), std::string::npos) << r.message;
+  EXPECT_EQ(r.message.find("particle"), std::string::npos) << r.message;
+  EXPECT_NEAR(r.end_time, 0.51, 1e-12);
 }
 
 }  // namespace

@@ -63,7 +63,7 @@ Noise run_column(const NoiseCase& c, hmpm::ShapeFunction shape) {
   p.gravity = {0, -c.g, 0};
   // Local damping brings the column to rest; at rest it vanishes (it is
   // proportional to the unbalanced force), so it does not bias the stresses.
-  p.local_damping = 0.3;
+  p.local_damping = problems::constant(0.3);
   hmpm::Boundary rollers;
   rollers.nodes.all = true;
   rollers.has_velocity = true;

@@ -221,8 +221,10 @@ struct Problem {
   OutputRequest output;
   /// Acceleration of gravity used for the unit weight of water gamma_w = rho_f * g.
   double gravity_constant = 9.81;
-  /// Local (Cundall) damping coefficient in [0, 1); 0 = none.
-  double local_damping = 0.0;
+  /// Local (Cundall) damping coefficient in [0, 1) as a function of time
+  /// (evaluated once per step, e.g. damping during a settling phase only);
+  /// empty = none. A value outside [0, 1) fails the run at that step.
+  FieldOfTime local_damping;
   InitialState initial_state;
 };
 
