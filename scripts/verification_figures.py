@@ -406,20 +406,157 @@ def collapse_figure(hmpm, work, out):
     return rows
 
 
+# ------------------------------------------------------------ saturated slope
+def slope_figure(spec, series, out, run_dir):
+    """The infinite slope of examples/slope-failure.json: pore pressures vs
+    the quasi-steady closed form, the mid column's slope-parallel
+    displacement vs the sliding block, the slope before and after."""
+    import meshio  # noqa: PLC0415 (only this figure reads snapshots)
+    import numpy as np  # noqa: PLC0415
+    g_vec = spec["gravity"]
+    g = math.hypot(*g_vec)
+    beta = math.atan2(g_vec[0], -g_vec[1])
+    mat = spec["materials"]["soil"]
+    hy = mat["hydraulic"]
+    n, rho_f = hy["porosity"], hy["fluid_density"]
+    rho = (1 - n) * mat["density"] + n * rho_f
+    E, nu = mat["youngs_modulus"], mat["poisson_ratio"]
+    E_oed = E * (1 - nu) / ((1 + nu) * (1 - 2 * nu))
+    c_v = hy["hydraulic_conductivity"] / (rho_f * g) / (1 / E_oed + n / hy["fluid_bulk_modulus"])
+    phi = math.radians(mat["friction_angle"])
+    H = spec["bodies"][0]["box"]["max"][1]
+    S = rho * g * math.cos(beta) * H
+    base = next(b for b in spec["boundaries"] if "pore_pressure" in b and b["pore_pressure"] != 0)
+    formula = base["pore_pressure"]  # muParser text that is also Python
+
+    def r(t):
+        return eval(formula, {"max": max, "abs": abs, "t": t}) / S  # noqa: S307
+
+    def r_rate(t, dt=1e-6):
+        return (r(t + dt) - r(t - dt)) / (2 * dt)
+
+    def p_exact(d, t):  # quasi-steady: steady profile plus the lag of a ramp
+        return r(t) * S * d / H + r_rate(t) * S / (6 * c_v * H) * (d ** 3 - H * H * d)
+
+    mu_davis, mu_coulomb = math.sin(phi), math.tan(phi)
+    r_f = 1 - math.tan(beta) / mu_davis
+    times = series["time"]
+    end = times[-1]
+
+    def block(mu, dt=1e-4):
+        x = v = 0.0
+        ts, xs = [0.0], [0.0]
+        t = 0.0
+        while t < end:
+            a = g * (math.sin(beta) - (1 - r(t)) * math.cos(beta) * mu)
+            if v <= 0 and a < 0:
+                a = v = 0.0
+            v += a * dt
+            x += v * dt
+            t += dt
+            ts.append(t)
+            xs.append(x)
+        return ts, xs
+
+    fs = [(1 - r(t)) * mu_davis / math.tan(beta) for t in times]
+    t_fail = next(0.001 * i for i in range(int(1000 * end)) if r(0.001 * i) >= r_f)
+    parts = series["particles"]
+    mean_u = [sum(p["displacement"][i][0] for p in parts) / len(parts) for i in range(len(times))]
+    t_peak = max(times, key=r)
+    worst_p = 0.0
+    for p in parts:
+        d = H - p["initial_position"][1]
+        for i, t in enumerate(times):
+            settled = abs(t - 0.5) > 5 * H * H / (math.pi ** 2 * c_v)
+            if settled and fs[i] >= 1.05 and t < t_peak:
+                worst_p = max(worst_p, abs(p["pore_pressure"][i] - p_exact(d, t)) / S)
+    tb, ub = block(mu_davis)
+    tc, uc = block(mu_coulomb)
+    onset = next(t for t, u in zip(times, mean_u) if u > 0.01 * H)
+    onset_block = next(t for t, u in zip(tb, ub) if u > 0.01 * H)
+    runout = mean_u[-1]
+
+    fig = plt.figure(figsize=(12, 7.5))
+    ax = fig.add_subplot(2, 2, 1)
+    for p in parts[::3]:
+        d = H - p["initial_position"][1]
+        line, = ax.plot(times, [v / S for v in p["pore_pressure"]], "o", ms=1.5, label=f"d = {d:.2f} m")
+        ax.plot(times, [p_exact(d, t) / S for t in times], "-", lw=0.8, color=line.get_color())
+    ax.axvline(t_fail, color="r", lw=0.7, ls="--")
+    ax.set_xlabel("t (s)")
+    ax.set_ylabel("p / (rho_sat g H cos beta)")
+    ax.set_title("pore pressure in the mid column, hmpm (dots) vs quasi-steady closed form (lines)", fontsize=8)
+    ax.legend(fontsize=7)
+    ax = fig.add_subplot(2, 2, 2)
+    ax.plot(times, mean_u, "k-", lw=2, label="hmpm, mid column (mean)")
+    ax.plot(tb, ub, "b--", lw=1, label="sliding block, mu = sin phi (Davis)")
+    ax.plot(tc, uc, "g--", lw=1, label="sliding block, mu = tan phi (Coulomb)")
+    ax.axvline(t_fail, color="r", lw=0.7, ls="--", label=f"FS = 1 (t = {t_fail:.2f} s)")
+    ax.set_xlabel("t (s)")
+    ax.set_ylabel("slope-parallel displacement (m)")
+    ax2 = ax.twinx()
+    ax2.plot(times, fs, color="0.6", lw=0.8)
+    ax2.axhline(1.0, color="0.6", lw=0.5, ls=":")
+    ax2.set_ylabel("FS (grey)")
+    ax.set_title("failure and runout", fontsize=8)
+    ax.legend(fontsize=7, loc="upper left")
+    ax = fig.add_subplot(2, 1, 2)
+    snaps = sorted(pathlib.Path(run_dir).glob("snapshot_*.vtu"))
+    cb, sb = math.cos(beta), math.sin(beta)
+
+    def real(x, y):  # slope coordinates to real-world horizontal and vertical
+        return x * cb + y * sb, -x * sb + y * cb
+
+    m = meshio.read(snaps[-1])
+    X, Z = real(m.points[:, 0], m.points[:, 1])
+    sc = ax.scatter(X, Z, s=1, c=m.point_data["displacement"][:, 0], cmap="viridis")
+    fig.colorbar(sc, ax=ax, label=f"slope-parallel displacement at t = {end:g} s (m)", shrink=0.8)
+    L = spec["bodies"][0]["box"]["max"][0]
+    X0, Z0 = real(np.array([0, L, L, 0, 0]), np.array([0, 0, H, H, 0]))
+    ax.plot(X0, Z0, "r-", lw=0.8, label="t = 0")
+    ax.legend(fontsize=7)
+    ax.set_aspect("equal")
+    ax.set_xlabel("horizontal (m)")
+    ax.set_ylabel("vertical (m)")
+    ax.set_title(f"the slope segment (beta = {math.degrees(beta):.0f} deg) before (red outline) and after the slide",
+                 fontsize=8)
+    fig.tight_layout()
+    fig.savefig(out / "slope-failure.png", dpi=110)
+    plt.close(fig)
+    return [("Saturated slope (infinite slope, pore-pressure pulse)",
+             "max |p - p_exact| / (rho_sat g H cos beta), mid column, FS >= 1.05", f"{100 * worst_p:.2f} %", "1 %"),
+            ("Saturated slope", "onset (mid column moved 0.01 H) vs sliding block, mu = sin phi",
+             f"{onset:.2f} s ({onset_block:.2f} s; FS = 1 at {t_fail:.2f} s)", "0.2 s"),
+            ("Saturated slope", "runout vs sliding block, mu = sin phi / tan phi",
+             f"{runout:.3f} m ({ub[-1]:.3f} / {uc[-1]:.3f} m)", "between the two")]
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--hmpm", default=str(REPO / "build" / "bin" / "hmpm"))
     ap.add_argument("--out", default=str(REPO / "docs" / "figures"))
+    ap.add_argument("--only", choices=["bar", "darcy", "terzaghi", "mandel", "collapse", "slope"],
+                    help="make one figure (and its table rows) only")
     args = ap.parse_args()
     out = pathlib.Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     rows = []
     with tempfile.TemporaryDirectory(prefix="hmpm-verification-") as work:
-        rows += bar_figure(*run_example(args.hmpm, "bar-vibration", work), out)
-        rows += darcy_figures(*run_example(args.hmpm, "darcy-flow", work), out)
-        rows += terzaghi_figure(*run_example(args.hmpm, "terzaghi", work), out)
-        rows += mandel_figure(*run_example(args.hmpm, "mandel", work), out)
-        rows += collapse_figure(args.hmpm, work, out)
+        def want(name):
+            return args.only in (None, name)
+        if want("bar"):
+            rows += bar_figure(*run_example(args.hmpm, "bar-vibration", work), out)
+        if want("darcy"):
+            rows += darcy_figures(*run_example(args.hmpm, "darcy-flow", work), out)
+        if want("terzaghi"):
+            rows += terzaghi_figure(*run_example(args.hmpm, "terzaghi", work), out)
+        if want("mandel"):
+            rows += mandel_figure(*run_example(args.hmpm, "mandel", work), out)
+        if want("collapse"):
+            rows += collapse_figure(args.hmpm, work, out)
+        if want("slope"):
+            rows += slope_figure(*run_example(args.hmpm, "slope-failure", work), out,
+                                 pathlib.Path(work) / "slope-failure")
     print("| problem | measure | hmpm | bound |")
     print("|---|---|---|---|")
     for r in rows:

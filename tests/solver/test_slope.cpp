@@ -1,8 +1,8 @@
 // A saturated infinite slope that fails under a pore-pressure pulse, slides
 // and stops (issue 7, item 3; docs/verification.md "Saturated slope").
 //
-// Set-up. A layer of thickness H on a rough, impermeable-to-nothing base
-// inclined at beta is modelled in slope coordinates: x along the slope
+// Set-up. A layer of thickness H on a rough base (no slip) whose pore
+// pressure is prescribed, inclined at beta, is modelled in slope coordinates: x along the slope
 // (downhill), y normal to it, gravity g (sin beta, -cos beta). A segment of
 // length L stands for the infinite slope: its two end faces carry the
 // tractions of the neighbouring slope (sigma . n of the in-situ stress, row
@@ -65,7 +65,9 @@ struct SlopeCase {
   double h() const { return H / cells; }
   double beta() const { return beta_deg * pi / 180; }
   double rho() const { return (1 - n) * rho_s + n * rho_f; }
-  double scale() const { return rho() * g * std::cos(beta()) * H; }  // total normal stress at the base
+  double scale() const {
+    return rho() * g * std::cos(beta()) * H;
+  }  // total normal stress at the base
   double kappa() const { return nu / (1 - nu); }
   double E_oed() const { return E * (1 - nu) / ((1 + nu) * (1 - 2 * nu)); }
   double c_v() const { return k / (rho_f * g * (1 / E_oed() + n / Kf)); }
@@ -133,9 +135,10 @@ hmpm::Problem slope_problem(const SlopeCase& c) {
   hmpm::Boundary base = problems::fixed_velocity(problems::plane(p, 1, 0.0), 1);
   base.friction = std::numeric_limits<double>::infinity();
   p.boundaries.push_back(base);
-  // Base pressure under the segment; p = 0 on the surface.
+  // Base pressure along the whole base (the piezometric level lies under
+  // all of the slope, also where the segment slides to); p = 0 on the surface.
   hmpm::Boundary pb;
-  pb.nodes.box.max = {c.L, 0, 0};
+  pb.nodes.box.max = {X, 0, 0};
   pb.pore_pressure = [c](double t) { return c.r(t) * c.scale(); };
   p.boundaries.push_back(pb);
   p.boundaries.push_back(problems::fixed_pressure(problems::plane(p, 1, c.H), 0.0));
@@ -205,12 +208,14 @@ SlopeRun run_slope(const SlopeCase& c, double end) {
       // time constant 0.08 s: 5 time constants).
       const bool settled = t < c.t0 || t > c.t0 + 5 * c.H * c.H / (pi * pi * c.c_v());
       const double err = std::abs(s.values[1][row * np + i] - c.pressure(d, t)) / c.scale();
-      if (settled && c.FS(t) >= 1.05 && t < c.t_peak()) out.max_p_error = std::max(out.max_p_error, err);
+      if (settled && c.FS(t) >= 1.05 && t < c.t_peak())
+        out.max_p_error = std::max(out.max_p_error, err);
       if (t > end - 0.3) out.max_p_error_after = std::max(out.max_p_error_after, err);
     }
     out.time.push_back(t);
     out.mean_u.push_back(u);
-    if (c.FS(t) >= 1.05 && t < c.t_peak()) out.max_u_at_rest = std::max(out.max_u_at_rest, std::abs(u));
+    if (c.FS(t) >= 1.05 && t < c.t_peak())
+      out.max_u_at_rest = std::max(out.max_u_at_rest, std::abs(u));
   }
   return out;
 }
@@ -247,13 +252,16 @@ TEST(Slope, FailsRunsOutAndStopsUnderAPorePressurePulse) {
   const std::size_t back = static_cast<std::size_t>(0.5 / 0.01);
   const double late_motion = runout - run.mean_u[run.mean_u.size() - 1 - back];
   std::printf(
-      "slope: r0 %.4f, r_f %.4f, t_f %.3f s; pressure error %.3g of the scale; at rest (FS >= 1.05) "
-      "max |u| %.3g m; onset (u = %.2g m) %.3f s, block %.3f s; runout %.3f m, block (mu = sin phi) "
+      "slope: r0 %.4f, r_f %.4f, t_f %.3f s; pressure error %.3g of the scale; at rest (FS >= "
+      "1.05) "
+      "max |u| %.3g m; onset (u = %.2g m) %.3f s, block %.3f s; runout %.3f m, block (mu = sin "
+      "phi) "
       "%.3f m, Coulomb (mu = tan phi) %.3f m; motion over the last 0.5 s %.2g m; pressure error "
-      "once stopped %.3g; friction of the block with that runout %.4f (sin phi %.4f, tan phi %.4f)\n",
+      "once stopped %.3g; friction of the block with that runout %.4f (sin phi %.4f, tan phi "
+      "%.4f)\n",
       c.r0(), c.r_fail(), c.t_fail(), run.max_p_error, run.max_u_at_rest, onset_level, t_onset,
-      t_onset_block, runout, block.back(), coulomb.back(), late_motion, run.max_p_error_after, mu_fit, c.mu(),
-      std::tan(c.phi_deg * pi / 180));
+      t_onset_block, runout, block.back(), coulomb.back(), late_motion, run.max_p_error_after,
+      mu_fit, c.mu(), std::tan(c.phi_deg * pi / 180));
   // Pore pressure before failure: the quasi-steady closed form, 1 % of the
   // scale (GIMP interpolation of a linear nodal field is exact; the lag term
   // it includes is 0.5 %; measured 0.35 %).
