@@ -239,6 +239,7 @@ TEST(Slope, FailsRunsOutAndStopsUnderAPorePressurePulse) {
   const double onset_level = 0.01 * c.H;
   const double t_onset = first_time_above(run.time, run.mean_u, onset_level);
   const double t_onset_block = first_time_above(tb, block, onset_level);
+  const double t_onset_coulomb = first_time_above(tb, coulomb, onset_level);
   const double runout = run.mean_u.back();
   // The friction the sliding block would need to run out as far (bisection;
   // the runout falls as mu grows).
@@ -254,14 +255,15 @@ TEST(Slope, FailsRunsOutAndStopsUnderAPorePressurePulse) {
   std::printf(
       "slope: r0 %.4f, r_f %.4f, t_f %.3f s; pressure error %.3g of the scale; at rest (FS >= "
       "1.05) "
-      "max |u| %.3g m; onset (u = %.2g m) %.3f s, block %.3f s; runout %.3f m, block (mu = sin "
+      "max |u| %.3g m; onset (u = %.2g m) %.3f s, block %.3f s (Coulomb %.3f s); runout %.3f m, "
+      "block (mu = sin "
       "phi) "
       "%.3f m, Coulomb (mu = tan phi) %.3f m; motion over the last 0.5 s %.2g m; pressure error "
       "once stopped %.3g; friction of the block with that runout %.4f (sin phi %.4f, tan phi "
       "%.4f)\n",
       c.r0(), c.r_fail(), c.t_fail(), run.max_p_error, run.max_u_at_rest, onset_level, t_onset,
-      t_onset_block, runout, block.back(), coulomb.back(), late_motion, run.max_p_error_after,
-      mu_fit, c.mu(), std::tan(c.phi_deg * pi / 180));
+      t_onset_block, t_onset_coulomb, runout, block.back(), coulomb.back(), late_motion,
+      run.max_p_error_after, mu_fit, c.mu(), std::tan(c.phi_deg * pi / 180));
   // Pore pressure before failure: the quasi-steady closed form, 1 % of the
   // scale (GIMP interpolation of a linear nodal field is exact; the lag term
   // it includes is 0.5 %; measured 0.35 %).
@@ -272,7 +274,9 @@ TEST(Slope, FailsRunsOutAndStopsUnderAPorePressurePulse) {
   EXPECT_LT(run.max_u_at_rest, 1e-3 * c.H);
   // Onset (the column has moved 0.01 H) within 0.2 s of the sliding block:
   // r rises 0.02 in 0.2 s, so the slope fails at FS = 1 +- 0.06.
+  // Coulomb's tan(phi) would fail it 0.45 s later: the tolerance tells them apart.
   EXPECT_NEAR(t_onset, t_onset_block, 0.2);
+  EXPECT_GT(std::abs(t_onset_coulomb - t_onset_block), 0.4);
   // It runs out, by more than the block would with Coulomb's tan(phi) on the
   // base and less than with the Davis friction sin(phi) (the bounds of the
   // friction a non-associated flow can mobilise on the slope-parallel plane;
