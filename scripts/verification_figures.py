@@ -489,6 +489,8 @@ def slope_figure(spec, series, out, run_dir):
     ax.legend(fontsize=7)
     ax = fig.add_subplot(2, 2, 2)
     ax.plot(times, mean_u, "k-", lw=2, label="hmpm, mid column (mean)")
+    top = max(parts, key=lambda p: p["initial_position"][1])
+    ax.plot(times, [u[0] for u in top["displacement"]], "k:", lw=1, label="hmpm, surface particle of that column")
     ax.plot(tb, ub, "b--", lw=1, label="sliding block, mu = sin phi (Davis)")
     ax.plot(tc, uc, "g--", lw=1, label="sliding block, mu = tan phi (Coulomb)")
     ax.axvline(t_fail, color="r", lw=0.7, ls="--", label=f"FS = 1 (t = {t_fail:.2f} s)")
