@@ -15,7 +15,9 @@
 // one-particle-per-cell layouts cannot enter the solution, and the linear
 // steady state is reproduced exactly at every particle. The Darcy term
 // rho_f a uses the nodal acceleration of the same step, interpolated to the
-// particle (see docs/verification.md for why this is stable).
+// particle (see docs/verification.md for why this is stable, and for the
+// compressible-fluid regime where the u-p equations themselves are not:
+// darcy_inertia_growth_ratio in materials.hpp).
 //
 // The step reads as named phases (see `step`). No phase allocates, calls a
 // virtual function or looks anything up by string.
@@ -106,6 +108,21 @@ class Simulation {
       inv_kf_.push_back(1.0 / h.fluid_bulk_modulus);
       fluid_ = fluid_ || m.hydraulic.has_value();
       plastic_ = plastic_ || constants_.back().model != Model::linear_elastic;
+      // Warn from a quarter of the equations' limit: with one particle per
+      // cell the discrete scheme grows from about 0.3 of it
+      // (docs/verification.md).
+      const double growth = darcy_inertia_growth_ratio(constants_.back());
+      if (growth > 0.25) {
+        const MaterialConstants& c = constants_.back();
+        warnings_.push_back(
+            "material '" + m.name + "': constrained modulus x storage (E_oed Q = " +
+            number(c.constrained_modulus * c.storage) + ") is " + number(growth) +
+            " times (rho - rho_f)/rho_f, above which the u-p equations with the rho_f a term of "
+            "Darcy's law have growing solutions (the scheme can grow from about 0.3 times it with "
+            "one particle per cell): oscillations can grow and the run can diverge. What to "
+            "change: a stiffer fluid_bulk_modulus, 2 or more particles per cell, local_damping "
+            "for quasi-static runs, or hydraulic.darcy_inertia = false (drops the term)");
+      }
     }
     for (int a = 0; a < Dim; ++a) gravity_[a] = problem_.gravity[a];
   }
@@ -601,7 +618,7 @@ class Simulation {
           grad_p += grid_.pressure[s.node[k]] * s.grad[k];
         particles_.darcy[p] =
             -mc.permeability_over_gamma * (grad_p - mc.fluid_density * gravity_ +
-                                           darcy_inertia_ * mc.fluid_density * a);
+                                           mc.darcy_inertia_density * a);
       }
     }
   }
@@ -801,10 +818,13 @@ class Simulation {
     failure_hint_ = std::move(hint);
   }
   void fail_nonfinite(std::size_t p, const char* what) {
-    record_failure(p, std::string("the ") + what + " became non-finite: the run diverged",
-                   "reduce time.dt or time.courant (the stable step estimate is " +
-                       number(stable_.limit) + " s), and check moduli, densities and loads for "
-                       "unrealistic values");
+    std::string hint = "reduce time.dt or time.courant (the stable step estimate is " +
+                       number(stable_.limit) +
+                       " s), and check moduli, densities and loads for unrealistic values";
+    if (!warnings_.empty())
+      hint += "; see the warnings: a material is where the u-p equations with Darcy's rho_f a "
+              "term grow (stiffer fluid_bulk_modulus or hydraulic.darcy_inertia = false)";
+    record_failure(p, std::string("the ") + what + " became non-finite: the run diverged", std::move(hint));
   }
   void fail_left_grid(std::size_t p) {
     record_failure(p, "the particle left the grid",
@@ -863,7 +883,7 @@ class Simulation {
   Vec grid_max_ = Vec::Zero();
   bool fluid_ = false;
   bool plastic_ = false;        ///< any material with a return mapping
-  double darcy_inertia_ = 1.0;  ///< weight of rho_f a in Darcy's law (1: as in the paper)
+  std::vector<std::string> warnings_;  ///< set-up findings the result reports
   double mass_tolerance_ = 0.0;
   StableStep stable_;
 
