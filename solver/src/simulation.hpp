@@ -14,10 +14,10 @@
 // equations see is the nodal field, the particle-level checkerboard mode of
 // one-particle-per-cell layouts cannot enter the solution, and the linear
 // steady state is reproduced exactly at every particle. The Darcy term
-// rho_f a uses the nodal acceleration of the same step, interpolated to the
-// particle (see docs/verification.md for why this is stable, and for the
-// compressible-fluid regime where the u-p equations themselves are not:
-// darcy_inertia_growth_ratio in materials.hpp).
+// rho_f a uses the acceleration of the re-mapped nodal velocities of the
+// same step, interpolated to the particle (see docs/verification.md for why
+// this is stable, and for the compressible-fluid regime where the u-p
+// equations themselves are not: darcy_inertia_growth_ratio in materials.hpp).
 //
 // The step reads as named phases (see `step`). No phase allocates, calls a
 // virtual function or looks anything up by string.
@@ -108,20 +108,19 @@ class Simulation {
       inv_kf_.push_back(1.0 / h.fluid_bulk_modulus);
       fluid_ = fluid_ || m.hydraulic.has_value();
       plastic_ = plastic_ || constants_.back().model != Model::linear_elastic;
-      // Warn from a quarter of the equations' limit: with one particle per
-      // cell the discrete scheme grows from about 0.3 of it
-      // (docs/verification.md).
+      // Warn from 0.9 of the equations' limit (the scheme's limit is the
+      // same, docs/verification.md): near it, waves hardly decay.
       const double growth = darcy_inertia_growth_ratio(constants_.back());
-      if (growth > 0.25) {
+      if (growth > 0.9) {
         const MaterialConstants& c = constants_.back();
         warnings_.push_back(
             "material '" + m.name + "': constrained modulus x storage (E_oed Q = " +
             number(c.constrained_modulus * c.storage) + ") is " + number(growth) +
             " times (rho - rho_f)/rho_f, above which the u-p equations with the rho_f a term of "
-            "Darcy's law have growing solutions (the scheme can grow from about 0.3 times it with "
-            "one particle per cell): oscillations can grow and the run can diverge. What to "
-            "change: a stiffer fluid_bulk_modulus, 2 or more particles per cell, local_damping "
-            "for quasi-static runs, or hydraulic.darcy_inertia = false (drops the term)");
+            "Darcy's law have growing solutions (near it, waves hardly decay): oscillations can "
+            "grow and the run can diverge. What to change: a stiffer fluid_bulk_modulus, "
+            "local_damping for quasi-static runs, or hydraulic.darcy_inertia = false (drops the "
+            "term)");
       }
     }
     for (int a = 0; a < Dim; ++a) gravity_[a] = problem_.gravity[a];
@@ -200,6 +199,16 @@ class Simulation {
       if (b.rigid[0] || b.rigid[1] || b.rigid[2]) rigid_ties_.push_back({nodes, b.rigid});
       if (b.pore_pressure && fluid_) pressure_bcs_.push_back({std::move(nodes), &*b.pore_pressure});
     }
+    if (!fluid_) return;
+    prescribed_axes_.assign(static_cast<std::size_t>(grid_.count), 0);
+    for (const VelocityConstraint& bc : velocity_bcs_)
+      for (int a = 0; a < Dim; ++a)
+        if (bc.fixed[a])
+          for (std::int64_t i : bc.nodes) prescribed_axes_[static_cast<std::size_t>(i)] |= std::uint8_t(1u << a);
+    for (const RigidTie& tie : rigid_ties_)
+      for (int a = 0; a < Dim; ++a)
+        if (tie.axes[a])
+          for (std::int64_t i : tie.nodes) prescribed_axes_[static_cast<std::size_t>(i)] |= std::uint8_t(1u << a);
   }
 
   /// Geostatic initial state (Problem::initial_state.geostatic): effective
@@ -324,7 +333,7 @@ class Simulation {
     for_particles(kRemap, [&](const Scatter& out, std::size_t b, std::size_t e) {
       update_particle_velocities_and_remap(out, b, e, dt);
     });
-    compute_remapped_nodal_velocity(t + dt);
+    compute_remapped_nodal_velocity(t + dt, dt);
     if (fluid_) {
       for_particles(kFlux, [&](const Scatter& out, std::size_t b, std::size_t e) {
         if (plastic_)
@@ -595,31 +604,17 @@ class Simulation {
   }
 
   /// Phase 3: FLIP update of particle velocities, v_p += dt sum N_i a_i, and
-  /// re-mapping of the updated momentum (MUSL, Eq. 26). Saturated particles
-  /// also compute their Darcy velocity here, where the nodal pressure
-  /// gradient and the solid acceleration of this step are both at hand.
+  /// re-mapping of the updated momentum (MUSL, Eq. 26).
   void update_particle_velocities_and_remap(const Scatter& out, std::size_t begin, std::size_t end,
                                             double dt) {
     StencilT s;
     for (std::size_t p = begin; p < end; ++p) {
-      if (fluid_) stencil_of<true>(p, s);  // the Darcy velocity needs grad p
-      else stencil_of<false>(p, s);
+      stencil_of<false>(p, s);
       Vec a = Vec::Zero();
       for (int k = 0; k < StencilT::N; ++k) a += s.w[k] * grid_.accel[s.node[k]];
       particles_.v[p] += dt * a;
       const Vec mv = particles_.mass[p] * particles_.v[p];
       for (int k = 0; k < StencilT::N; ++k) out.remap[s.node[k]] += s.w[k] * mv;
-      if (fluid_) {
-        const std::uint16_t mat = particles_.material[p];
-        const MaterialConstants& mc = constants_[mat];
-        if (!mc.saturated) continue;
-        Vec grad_p = Vec::Zero();
-        for (int k = 0; k < StencilT::N; ++k)
-          grad_p += grid_.pressure[s.node[k]] * s.grad[k];
-        particles_.darcy[p] =
-            -mc.permeability_over_gamma * (grad_p - mc.fluid_density * gravity_ +
-                                           mc.darcy_inertia_density * a);
-      }
     }
   }
 
@@ -662,7 +657,7 @@ class Simulation {
     }
   }
 
-  void compute_remapped_nodal_velocity(double t_new) {
+  void compute_remapped_nodal_velocity(double t_new, double dt) {
     for (RigidTie& tie : rigid_ties_)
       for (int a = 0; a < Dim; ++a) {
         if (!tie.axes[a]) continue;
@@ -694,6 +689,21 @@ class Simulation {
         const double v = (*bc.fn[a])(t_new);
         for (std::int64_t i : bc.nodes) grid_.remap[i][a] = v;
       }
+    if (!fluid_) return;
+    // Darcy's rho_f a takes the acceleration of the re-mapped field,
+    // (v_remap - v^n) / dt, at free components: it has passed through the
+    // same particle-grid smoothing as the velocities the mass balance sees,
+    // so the elastic part of rho_f a is never stronger than the pressure
+    // diffusion that balances it (docs/verification.md). Prescribed and
+    // rigid components keep the acceleration of update_nodal_momentum.
+    const double inv_dt = 1.0 / dt;
+    for (std::int64_t i = 0; i < grid_.count; ++i) {
+      const double m = grid_.mass[i];
+      if (m <= mass_tolerance_) continue;
+      const std::uint8_t fixed = prescribed_axes_[static_cast<std::size_t>(i)];
+      for (int a = 0; a < Dim; ++a)
+        if (!(fixed & (1u << a))) grid_.accel[i][a] = (grid_.remap[i][a] - grid_.momentum[i][a] / m) * inv_dt;
+    }
   }
 
   /// Phase 4: strain increment from the re-mapped nodal velocities, stress
@@ -715,7 +725,14 @@ class Simulation {
       const MaterialConstants& mc = constants_[mat];
       if (fluid_ && mc.saturated) {
         const double div_v = grad_v.trace();
-        const Vec& w = particles_.darcy[p];
+        Vec grad_p = Vec::Zero(), a = Vec::Zero();
+        for (int k = 0; k < StencilT::N; ++k) {
+          grad_p += grid_.pressure[s.node[k]] * s.grad[k];
+          a += s.w[k] * grid_.accel[s.node[k]];
+        }
+        const Vec w = -mc.permeability_over_gamma *
+                      (grad_p - mc.fluid_density * gravity_ + mc.darcy_inertia_density * a);
+        particles_.darcy[p] = w;
         for (int k = 0; k < StencilT::N; ++k)
           out.flux[s.node[k]] +=
               vol * (s.grad[k].dot(w) - s.w[k] * div_v);
@@ -884,6 +901,8 @@ class Simulation {
   bool fluid_ = false;
   bool plastic_ = false;        ///< any material with a return mapping
   std::vector<std::string> warnings_;  ///< set-up findings the result reports
+  /// Per node (saturated runs): bit a set when a boundary prescribes or ties component a.
+  std::vector<std::uint8_t> prescribed_axes_;
   double mass_tolerance_ = 0.0;
   StableStep stable_;
 

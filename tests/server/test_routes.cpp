@@ -407,8 +407,15 @@ TEST_F(RoutesTest, ListFiltersAndMetricsCount) {
   EXPECT_EQ(json_of(client_->Get("/jobs?status=accepted,running,successful")->body)["jobs"].size(),
             2u);
 
-  res = client_->Get("/metrics");
-  ASSERT_TRUE(res);
+  // cpp-httplib calls the logger, which counts requests, after the response
+  // is written: the client can see the second 201 before it is counted, so
+  // poll briefly (bounded) for the count instead of reading it once.
+  const auto deadline = Clock::now() + std::chrono::seconds(5);
+  do {
+    res = client_->Get("/metrics");
+    ASSERT_TRUE(res);
+  } while (res->body.find("hmpm_http_requests_total{code=\"201\"} 2") == std::string::npos &&
+           Clock::now() < deadline);
   EXPECT_EQ(res->status, 200);
   EXPECT_NE(res->body.find("hmpm_jobs{status=\"successful\"} "), std::string::npos) << res->body;
   EXPECT_NE(res->body.find("hmpm_queue_length "), std::string::npos);

@@ -217,8 +217,8 @@ TEST(DarcyInertia, SameStepAccelerationIsStable) {
 // soft fluid must decay. Tolerance: the fitted rate within 5 % of 2 Re(s)
 // (the energy of a damped mode oscillates at twice the frequency about the
 // exponential, and the 20-cell grid shifts the frequency by ~0.5 %; measured
-// deviations 0.4-0.8 %, printed). The run's warnings flag materials from a
-// quarter of the limit on (the discrete margin, docs/verification.md).
+// deviations 0.3-1.1 %, printed). The run's warnings flag materials from
+// 0.9 of the limit on.
 TEST(DarcyInertia, CompressibleFluidGrowsAtTheRateOfTheEquations) {
   const double E = 20e6, rho_s = 2000, rho_f = 1000, n = 0.3, k = 0.1, L = 1.0, g = 9.81;
   const double rho = (1 - n) * rho_s + n * rho_f, limit = (rho - rho_f) / rho_f;
@@ -277,7 +277,7 @@ TEST(DarcyInertia, CompressibleFluidGrowsAtTheRateOfTheEquations) {
                 c.inertia ? "on" : "off", c.times_limit, measured, predicted);
     EXPECT_NEAR(measured, predicted, 0.05 * std::abs(predicted));
     const bool warned = !r.warnings.empty();
-    EXPECT_EQ(warned, c.inertia && c.times_limit > 0.25) << (warned ? r.warnings[0] : "");
+    EXPECT_EQ(warned, c.inertia && c.times_limit > 0.9) << (warned ? r.warnings[0] : "");
     if (warned) {
       EXPECT_NE(r.warnings[0].find("darcy_inertia"), std::string::npos);
     }
