@@ -209,6 +209,8 @@ ParseResult JobParser::parse(std::string_view text) {
     ParsedJob job;
     job.name = name_;
     job.cost = estimate_cost(p_);
+    for (const ProblemIssue& w : problem_warnings(p_))
+      job.warnings.push_back({pointer_for(w.where), w.message});
     job.problem = std::move(p_);
     result.job = std::move(job);
   }

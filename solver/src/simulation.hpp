@@ -108,21 +108,9 @@ class Simulation {
       inv_kf_.push_back(1.0 / h.fluid_bulk_modulus);
       fluid_ = fluid_ || m.hydraulic.has_value();
       plastic_ = plastic_ || constants_.back().model != Model::linear_elastic;
-      // Warn from 0.9 of the equations' limit (the scheme's limit is the
-      // same, docs/verification.md): near it, waves hardly decay.
-      const double growth = darcy_inertia_growth_ratio(constants_.back());
-      if (growth > 0.9) {
-        const MaterialConstants& c = constants_.back();
-        warnings_.push_back(
-            "material '" + m.name + "': constrained modulus x storage (E_oed Q = " +
-            number(c.constrained_modulus * c.storage) + ") is " + number(growth) +
-            " times (rho - rho_f)/rho_f, above which the u-p equations with the rho_f a term of "
-            "Darcy's law have growing solutions (near it, waves hardly decay): oscillations can "
-            "grow and the run can diverge. What to change: a stiffer fluid_bulk_modulus, "
-            "local_damping for quasi-static runs, or hydraulic.darcy_inertia = false (drops the "
-            "term)");
-      }
     }
+    for (const ProblemIssue& w : problem_warnings(problem_))
+      warnings_.push_back(w.where + ": " + w.message);
     for (int a = 0; a < Dim; ++a) gravity_[a] = problem_.gravity[a];
   }
 
