@@ -10,6 +10,7 @@
 # every row is the best of REPEAT runs (default 2) to shave off interference.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+bash scripts/install-deps.sh >/dev/null  # wrk, valgrind, the build tools
 # shellcheck source=bench/doc_section.sh
 source bench/doc_section.sh
 

@@ -14,6 +14,7 @@
 # service:end unless --no-doc.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+bash scripts/install-deps.sh >/dev/null  # wrk, valgrind, the build tools
 # shellcheck source=bench/doc_section.sh
 source bench/doc_section.sh
 write_doc=1

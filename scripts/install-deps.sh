@@ -13,7 +13,8 @@ packages=(
   libcpp-httplib-dev       # server: HTTP (0.11.4, compiled library)
   libssl-dev zlib1g-dev libbrotli-dev  # what libcpp-httplib links against
   libgtest-dev libgmock-dev            # tests
-  libbenchmark-dev                     # bench/
+  libbenchmark-dev wrk                 # bench/ (wrk: bench/service.sh status reads)
+  valgrind                             # docs/performance.md instruction counts
   python3                              # clients and result checks
   python3-meshio python3-matplotlib python3-jsonschema python3-numpy
 )

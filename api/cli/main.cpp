@@ -104,6 +104,7 @@ int command_validate(const std::vector<std::string>& args) {
   if (const int rc = load(args[0], result); rc != kExitOk) return rc;
   std::cout << "valid: " << result.job->name << "\n";
   print_cost(result.job->cost);
+  for (const auto& w : result.job->warnings) std::cerr << "hmpm: warning: " << w.path << ": " << w.message << "\n";
   return kExitOk;
 }
 

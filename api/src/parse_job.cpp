@@ -37,7 +37,7 @@ constexpr std::string_view kPlasticKeys[] = {"friction_angle", "dilatancy_angle"
                                              "tensile_strength"};
 constexpr std::string_view kHydraulic[] = {"porosity", "hydraulic_conductivity",
                                            "fluid_bulk_modulus", "fluid_density",
-                                           "solid_bulk_modulus"};
+                                           "solid_bulk_modulus", "darcy_inertia"};
 constexpr std::string_view kHydraulicRequired[] = {"porosity", "hydraulic_conductivity",
                                                    "fluid_bulk_modulus"};
 constexpr std::string_view kBody[] = {"material", "box", "particles_per_cell", "initial"};
@@ -210,6 +210,8 @@ ParseResult JobParser::parse(std::string_view text) {
     ParsedJob job;
     job.name = name_;
     job.cost = estimate_cost(p_);
+    for (const ProblemIssue& w : problem_warnings(p_))
+      job.warnings.push_back({pointer_for(w.where), w.message});
     job.problem = std::move(p_);
     result.job = std::move(job);
   }
@@ -395,6 +397,8 @@ void JobParser::parse_hydraulic(Material& m, const json& j, const std::string& p
   r_.number_at(j, path, "fluid_bulk_modulus", Range::positive(), h.fluid_bulk_modulus);
   r_.number_at(j, path, "fluid_density", Range::positive(), h.fluid_density);
   r_.number_at(j, path, "solid_bulk_modulus", Range::positive(), h.solid_bulk_modulus);
+  if (j.contains("darcy_inertia"))
+    if (auto v = r_.boolean(j["darcy_inertia"], path + "/darcy_inertia")) h.darcy_inertia = *v;
   m.hydraulic = h;
 }
 
@@ -590,11 +594,9 @@ void JobParser::parse_boundary(const json& j, const std::string& path) {
     if (r_.per_axis(v, vp, dim_, "true or false")) {
       for (std::size_t a = 0; a < v.size() && a < 3; ++a) {
         const std::string ap = child_pointer(vp, a);
-        if (!v[a].is_boolean()) {
-          r_.error(ap, std::string("expected true or false, got ") + v[a].type_name());
-          continue;
-        }
-        b.rigid[a] = v[a].get<bool>();
+        const auto tied = r_.boolean(v[a], ap);
+        if (!tied) continue;
+        b.rigid[a] = *tied;
         if (b.rigid[a] && b.velocity[a])
           r_.error(ap, "is true but velocity/" + std::to_string(a) +
                            " prescribes that component; a rigid tie needs it free");

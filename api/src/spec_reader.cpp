@@ -297,6 +297,12 @@ std::optional<double> SpecReader::number(const json& j, const std::string& path,
   return v;
 }
 
+std::optional<bool> SpecReader::boolean(const json& j, const std::string& path) {
+  if (j.is_boolean()) return j.get<bool>();
+  error(path, std::string("expected true or false, got ") + j.type_name());
+  return std::nullopt;
+}
+
 std::optional<std::int64_t> SpecReader::integer(const json& j, const std::string& path,
                                                 std::int64_t lo, std::int64_t hi) {
   const std::string want = "an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]";

@@ -83,6 +83,8 @@ class SpecReader {
     if (v) target = *v;
     return v.has_value();
   }
+  /// true or false.
+  std::optional<bool> boolean(const json& j, const std::string& path);
   /// An integer (a number with an integral value) in [lo, hi].
   std::optional<std::int64_t> integer(const json& j, const std::string& path, std::int64_t lo,
                                       std::int64_t hi);

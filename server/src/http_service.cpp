@@ -471,16 +471,28 @@ void Service::Impl::post_job(const Request& req, Response& res,
   job.idempotency_key = key;
   if (!key.empty()) job.body_sha256 = sha256_hex(body);
   const SubmitResult submitted = store.submit(job, config.max_queue);
+  // The 201 also carries the spec's warnings (runnable, but worth knowing);
+  // the run's summary.json repeats them.
+  const auto accepted_document = [&] {
+    Json doc = status_document(submitted.job);
+    if (!parsed.job->warnings.empty()) {
+      Json warnings = Json::array();
+      for (const auto& w : parsed.job->warnings)
+        warnings.push_back(Json{{"path", w.path}, {"message", w.message}});
+      doc["warnings"] = std::move(warnings);
+    }
+    return doc;
+  };
   switch (submitted.outcome) {
     case SubmitOutcome::created:
       log_line({{"event", "job"}, {"job", job.id}, {"status", "accepted"}, {"name", job.name}});
       workers.notify();
       res.set_header("Location", "/jobs/" + job.id);
-      return send_json(res, 201, status_document(submitted.job));
+      return send_json(res, 201, accepted_document());
     case SubmitOutcome::replayed:
       res.set_header("Location", "/jobs/" + submitted.job.id);
       res.set_header("Idempotent-Replayed", "true");
-      return send_json(res, 201, status_document(submitted.job));
+      return send_json(res, 201, accepted_document());
     case SubmitOutcome::key_conflict:
       return send_problem(res, 422, "idempotency-key-reused", "Idempotency key reused",
                           "this Idempotency-Key was used for a different job spec",

@@ -36,6 +36,7 @@ struct MaterialConstants {
   double undrained_p_modulus = 0.0;  ///< constrained modulus + 1/Q (saturated), Pa
   double fluid_density = 0.0;
   double permeability_over_gamma = 0.0;  ///< k / (rho_f g), m^3 s / kg
+  double darcy_inertia_density = 0.0;    ///< rho_f, or 0 when Darcy's rho_f a is dropped
 };
 
 inline MaterialConstants material_constants(const Material& m, double gravity_constant) {
@@ -69,8 +70,25 @@ inline MaterialConstants material_constants(const Material& m, double gravity_co
     c.storage = solid_term + h.porosity / h.fluid_bulk_modulus;
     c.undrained_p_modulus += 1.0 / c.storage;
     c.permeability_over_gamma = h.hydraulic_conductivity / (h.fluid_density * gravity_constant);
+    c.darcy_inertia_density = h.darcy_inertia ? h.fluid_density : 0.0;
   }
   return c;
+}
+
+/// The u-p equations with Darcy's rho_f a term are not dissipative: one
+/// Fourier mode of the 1D equations has the characteristic polynomial
+///   rho Q s^3 + rho k' q^2 s^2 + q^2 (E Q + 1) s + E k q^4,
+/// (k = k/gamma_w, k' = k (1 - rho_f/rho), E the constrained modulus), and
+/// Routh-Hurwitz makes every mode grow when E Q > (rho - rho_f)/rho_f, for
+/// any wavenumber and any permeability > 0. This returns
+/// E Q rho_f / (rho - rho_f): above 1 the material is in that regime
+/// (infinity when the grains are not denser than the fluid), 0 when the
+/// term is dropped or nothing flows.
+inline double darcy_inertia_growth_ratio(const MaterialConstants& c) {
+  if (!c.saturated || c.darcy_inertia_density <= 0.0 || c.permeability_over_gamma <= 0.0) return 0.0;
+  const double buoyant = c.mixture_density - c.fluid_density;
+  if (buoyant <= 0.0) return std::numeric_limits<double>::infinity();
+  return c.constrained_modulus * c.storage * c.fluid_density / buoyant;
 }
 
 }  // namespace hmpm

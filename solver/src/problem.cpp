@@ -169,6 +169,34 @@ std::string fmt(double v) {
 
 }  // namespace
 
+std::vector<ProblemIssue> problem_warnings(const Problem& problem) {
+  std::vector<ProblemIssue> warnings;
+  for (const Material& m : problem.materials) {
+    const MaterialConstants c = material_constants(m, problem.gravity_constant);
+    // From 0.9 of the equations' limit (the scheme's limit is the same):
+    // near it, waves hardly decay.
+    const double growth = darcy_inertia_growth_ratio(c);
+    if (growth <= 0.9) continue;
+    const std::string what =
+        std::isinf(growth)
+            ? "the grains are not denser than the fluid (density " + fmt(m.density) +
+                  " kg/m3, fluid " + fmt(c.fluid_density) +
+                  "), so the u-p equations with the rho_f a term of Darcy's law have growing "
+                  "solutions for any stiffness: oscillations can grow and the run can diverge. "
+                  "What to change: check density (the grain density, not the mixture's), or "
+                  "set darcy_inertia: false (drops the term)"
+            : "constrained modulus x storage (E_oed Q = " + fmt(c.constrained_modulus * c.storage) +
+                  ") is " + fmt(growth) +
+                  " times (rho - rho_f)/rho_f, above which the u-p equations with the rho_f a "
+                  "term of Darcy's law have growing solutions (near it, waves hardly decay): "
+                  "oscillations can grow and the run can diverge. What to change: a stiffer "
+                  "fluid_bulk_modulus, local_damping for quasi-static runs, or darcy_inertia: "
+                  "false (drops the term)";
+    warnings.push_back({"materials/" + m.name + "/hydraulic", what});
+  }
+  return warnings;
+}
+
 std::vector<ProblemIssue> check_problem(const Problem& problem) {
   std::vector<ProblemIssue> issues;
   auto add = [&](std::string where, std::string msg) {

@@ -14,8 +14,10 @@
 // equations see is the nodal field, the particle-level checkerboard mode of
 // one-particle-per-cell layouts cannot enter the solution, and the linear
 // steady state is reproduced exactly at every particle. The Darcy term
-// rho_f a uses the nodal acceleration of the same step, interpolated to the
-// particle (see docs/verification.md for why this is stable).
+// rho_f a uses the acceleration of the re-mapped nodal velocities of the
+// same step, interpolated to the particle (see docs/verification.md for why
+// this is stable, and for the compressible-fluid regime where the u-p
+// equations themselves are not: darcy_inertia_growth_ratio in materials.hpp).
 //
 // The step reads as named phases (see `step`). No phase allocates, calls a
 // virtual function or looks anything up by string.
@@ -107,6 +109,8 @@ class Simulation {
       fluid_ = fluid_ || m.hydraulic.has_value();
       plastic_ = plastic_ || constants_.back().model != Model::linear_elastic;
     }
+    for (const ProblemIssue& w : problem_warnings(problem_))
+      warnings_.push_back(w.where + ": " + w.message);
     for (int a = 0; a < Dim; ++a) gravity_[a] = problem_.gravity[a];
   }
 
@@ -183,6 +187,16 @@ class Simulation {
       if (b.rigid[0] || b.rigid[1] || b.rigid[2]) rigid_ties_.push_back({nodes, b.rigid});
       if (b.pore_pressure && fluid_) pressure_bcs_.push_back({std::move(nodes), &*b.pore_pressure});
     }
+    if (!fluid_) return;
+    prescribed_axes_.assign(static_cast<std::size_t>(grid_.count), 0);
+    for (const VelocityConstraint& bc : velocity_bcs_)
+      for (int a = 0; a < Dim; ++a)
+        if (bc.fixed[a])
+          for (std::int64_t i : bc.nodes) prescribed_axes_[static_cast<std::size_t>(i)] |= std::uint8_t(1u << a);
+    for (const RigidTie& tie : rigid_ties_)
+      for (int a = 0; a < Dim; ++a)
+        if (tie.axes[a])
+          for (std::int64_t i : tie.nodes) prescribed_axes_[static_cast<std::size_t>(i)] |= std::uint8_t(1u << a);
   }
 
   /// Geostatic initial state (Problem::initial_state.geostatic): effective
@@ -313,7 +327,7 @@ class Simulation {
     for_particles(kRemap, [&](const Scatter& out, std::size_t b, std::size_t e) {
       update_particle_velocities_and_remap(out, b, e, dt);
     });
-    compute_remapped_nodal_velocity(t + dt);
+    compute_remapped_nodal_velocity(t + dt, dt);
     if (fluid_) {
       for_particles(kFlux, [&](const Scatter& out, std::size_t b, std::size_t e) {
         if (plastic_)
@@ -584,31 +598,17 @@ class Simulation {
   }
 
   /// Phase 3: FLIP update of particle velocities, v_p += dt sum N_i a_i, and
-  /// re-mapping of the updated momentum (MUSL, Eq. 26). Saturated particles
-  /// also compute their Darcy velocity here, where the nodal pressure
-  /// gradient and the solid acceleration of this step are both at hand.
+  /// re-mapping of the updated momentum (MUSL, Eq. 26).
   void update_particle_velocities_and_remap(const Scatter& out, std::size_t begin, std::size_t end,
                                             double dt) {
     StencilT s;
     for (std::size_t p = begin; p < end; ++p) {
-      if (fluid_) stencil_of<true>(p, s);  // the Darcy velocity needs grad p
-      else stencil_of<false>(p, s);
+      stencil_of<false>(p, s);
       Vec a = Vec::Zero();
       for (int k = 0; k < StencilT::N; ++k) a += s.w[k] * grid_.accel[s.node[k]];
       particles_.v[p] += dt * a;
       const Vec mv = particles_.mass[p] * particles_.v[p];
       for (int k = 0; k < StencilT::N; ++k) out.remap[s.node[k]] += s.w[k] * mv;
-      if (fluid_) {
-        const std::uint16_t mat = particles_.material[p];
-        const MaterialConstants& mc = constants_[mat];
-        if (!mc.saturated) continue;
-        Vec grad_p = Vec::Zero();
-        for (int k = 0; k < StencilT::N; ++k)
-          grad_p += grid_.pressure[s.node[k]] * s.grad[k];
-        particles_.darcy[p] =
-            -mc.permeability_over_gamma * (grad_p - mc.fluid_density * gravity_ +
-                                           darcy_inertia_ * mc.fluid_density * a);
-      }
     }
   }
 
@@ -651,7 +651,7 @@ class Simulation {
     }
   }
 
-  void compute_remapped_nodal_velocity(double t_new) {
+  void compute_remapped_nodal_velocity(double t_new, double dt) {
     for (RigidTie& tie : rigid_ties_)
       for (int a = 0; a < Dim; ++a) {
         if (!tie.axes[a]) continue;
@@ -683,6 +683,21 @@ class Simulation {
         const double v = (*bc.fn[a])(t_new);
         for (std::int64_t i : bc.nodes) grid_.remap[i][a] = v;
       }
+    if (!fluid_) return;
+    // Darcy's rho_f a takes the acceleration of the re-mapped field,
+    // (v_remap - v^n) / dt, at free components: it has passed through the
+    // same particle-grid smoothing as the velocities the mass balance sees,
+    // so the elastic part of rho_f a is never stronger than the pressure
+    // diffusion that balances it (docs/verification.md). Prescribed and
+    // rigid components keep the acceleration of update_nodal_momentum.
+    const double inv_dt = 1.0 / dt;
+    for (std::int64_t i = 0; i < grid_.count; ++i) {
+      const double m = grid_.mass[i];
+      if (m <= mass_tolerance_) continue;
+      const std::uint8_t fixed = prescribed_axes_[static_cast<std::size_t>(i)];
+      for (int a = 0; a < Dim; ++a)
+        if (!(fixed & (1u << a))) grid_.accel[i][a] = (grid_.remap[i][a] - grid_.momentum[i][a] / m) * inv_dt;
+    }
   }
 
   /// Phase 4: strain increment from the re-mapped nodal velocities, stress
@@ -704,7 +719,14 @@ class Simulation {
       const MaterialConstants& mc = constants_[mat];
       if (fluid_ && mc.saturated) {
         const double div_v = grad_v.trace();
-        const Vec& w = particles_.darcy[p];
+        Vec grad_p = Vec::Zero(), a = Vec::Zero();
+        for (int k = 0; k < StencilT::N; ++k) {
+          grad_p += grid_.pressure[s.node[k]] * s.grad[k];
+          a += s.w[k] * grid_.accel[s.node[k]];
+        }
+        const Vec w = -mc.permeability_over_gamma *
+                      (grad_p - mc.fluid_density * gravity_ + mc.darcy_inertia_density * a);
+        particles_.darcy[p] = w;
         for (int k = 0; k < StencilT::N; ++k)
           out.flux[s.node[k]] +=
               vol * (s.grad[k].dot(w) - s.w[k] * div_v);
@@ -815,10 +837,13 @@ class Simulation {
     failure_hint_ = std::move(hint);
   }
   void fail_nonfinite(std::size_t p, const char* what) {
-    record_failure(p, std::string("the ") + what + " became non-finite: the run diverged",
-                   "reduce time.dt or time.courant (the stable step estimate is " +
-                       number(stable_.limit) + " s), and check moduli, densities and loads for "
-                       "unrealistic values");
+    std::string hint = "reduce time.dt or time.courant (the stable step estimate is " +
+                       number(stable_.limit) +
+                       " s), and check moduli, densities and loads for unrealistic values";
+    if (!warnings_.empty())
+      hint += "; see the warnings: a material is where the u-p equations with Darcy's rho_f a "
+              "term grow (stiffer fluid_bulk_modulus or hydraulic.darcy_inertia = false)";
+    record_failure(p, std::string("the ") + what + " became non-finite: the run diverged", std::move(hint));
   }
   void fail_left_grid(std::size_t p) {
     record_failure(p, "the particle left the grid",
@@ -877,7 +902,9 @@ class Simulation {
   Vec grid_max_ = Vec::Zero();
   bool fluid_ = false;
   bool plastic_ = false;        ///< any material with a return mapping
-  double darcy_inertia_ = 1.0;  ///< weight of rho_f a in Darcy's law (1: as in the paper)
+  std::vector<std::string> warnings_;  ///< set-up findings the result reports
+  /// Per node (saturated runs): bit a set when a boundary prescribes or ties component a.
+  std::vector<std::uint8_t> prescribed_axes_;
   double mass_tolerance_ = 0.0;
   StableStep stable_;
 

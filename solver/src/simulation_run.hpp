@@ -107,6 +107,7 @@ RunResult Simulation<Dim, Shape>::run(const RunOptions& options) {
   result.nodes = grid_.count;
   result.state_bytes = particles_.bytes() + grid_.bytes() * threads;
   result.threads = threads;
+  result.warnings = warnings_;
 
   // Output set-up.
   const OutputRequest& out = problem_.output;

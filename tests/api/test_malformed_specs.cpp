@@ -62,6 +62,8 @@ const Mutation kMutations[] = {
      "got boolean"},
     {"missing_hydraulic_key", "/materials/sand/hydraulic/fluid_bulk_modulus", nullptr,
      "/materials/sand/hydraulic/fluid_bulk_modulus", "is required"},
+    {"darcy_inertia_not_boolean", "/materials/sand/hydraulic/darcy_inertia", "\"no\"",
+     "/materials/sand/hydraulic/darcy_inertia", "true or false"},
     {"materials_empty", "/materials", "{}", "/materials", "at least one material"},
     {"unknown_material", "/bodies/0/material", "\"clay\"", "/bodies/0/material",
      "unknown material 'clay'"},

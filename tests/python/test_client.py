@@ -39,6 +39,17 @@ class ClientTest(LiveServerCase):
             self.assertIn(key, doc)
         job.wait(progress=False, timeout=JOB_TIMEOUT_S)
 
+    def test_submit_keeps_the_spec_warnings(self):
+        # A fluid 75 times softer than in column_spec: E_oed Q = 4, about 4 times
+        # the u-p stability limit (rho - rho_f)/rho_f = 0.99 (docs/verification.md).
+        spec = column_spec()
+        spec["materials"]["clay"]["hydraulic"]["fluid_bulk_modulus"] = 1.0e6
+        job = self.client.submit(spec)
+        self.assertEqual([w["path"] for w in job.warnings], ["/materials/clay/hydraulic"])
+        self.assertIn("What to change", job.warnings[0]["message"])
+        job.wait(progress=False, timeout=JOB_TIMEOUT_S)
+        self.assertEqual(self.client.submit(bar_spec()).warnings, [])
+
     def test_spec_comes_back(self):
         spec = bar_spec()
         job = self.client.submit(spec)

@@ -125,6 +125,8 @@ def cmd_submit(client: Client, args) -> int:
         spec = args.spec
     job = client.submit(spec, idempotency_key=args.idempotency_key)
     print(job.id, flush=True)
+    for w in job.warnings:
+        _err(f"warning: {w.get('path', '')}: {w.get('message', '')}")
     if not (args.wait or args.download):
         return EXIT_OK
     doc = _wait(job, args)

@@ -173,6 +173,8 @@ class Client:
         job = Job(self, str(job_id), doc if isinstance(doc, dict) else {})
         job.end_time = _spec_end_time(body)
         job.replayed = replayed
+        warnings = doc.get("warnings") if isinstance(doc, dict) else None
+        job.warnings = [w for w in warnings if isinstance(w, dict)] if isinstance(warnings, list) else []
         return job
 
     def job(self, job_id: str) -> "Job":
@@ -232,6 +234,9 @@ class Job:
         self.doc: Dict[str, Any] = dict(doc or {})
         self.end_time: Optional[float] = None  # the spec's time.end, when known
         self.replayed = False  # submit() returned an earlier job for its idempotency key
+        # What the service warned about at submission ({"path", "message"} each):
+        # the spec is valid but something is worth knowing before it runs.
+        self.warnings: List[Dict[str, Any]] = []
 
     def __repr__(self) -> str:
         return f"Job({self.id!r}, status={self.doc.get('status')!r})"

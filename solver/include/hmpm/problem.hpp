@@ -58,6 +58,10 @@ struct Hydraulic {
   double fluid_density = 1000.0;         ///< rho_f in kg/m^3
   /// Ks in Pa; infinity means incompressible grains.
   double solid_bulk_modulus = std::numeric_limits<double>::infinity();
+  /// Keep the fluid-acceleration term rho_f a of Darcy's law (the paper's
+  /// u-p model). false drops it (the low-frequency u-p simplification);
+  /// see docs/verification.md for when that is needed.
+  bool darcy_inertia = true;
 };
 
 struct LinearElastic {};

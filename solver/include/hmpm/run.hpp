@@ -46,6 +46,13 @@ StableStep stable_step(const Problem& problem);
 /// Returns every issue found; empty means runnable.
 std::vector<ProblemIssue> check_problem(const Problem& problem);
 
+/// Things in a runnable Problem a user should know before running: each a
+/// `where` in the job-spec vocabulary and a message saying what to change.
+/// Today: materials whose fluid is so compressible that the u-p equations
+/// with Darcy's rho_f a term are near or past their stability limit
+/// (docs/verification.md). The run's RunResult::warnings repeat them.
+std::vector<ProblemIssue> problem_warnings(const Problem& problem);
+
 /// Number of particles the bodies generate (cheap; no allocation per particle).
 std::int64_t count_particles(const Problem& problem);
 

@@ -62,6 +62,9 @@ struct ParsedJob {
   std::string name;
   hmpm::Problem problem;
   CostEstimate cost;
+  /// Runnable, but worth knowing before running (hmpm::problem_warnings),
+  /// with JSON pointers like errors; the run's summary repeats them.
+  std::vector<SpecError> warnings;
 };
 
 struct ParseResult {
