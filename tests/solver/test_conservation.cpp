@@ -168,8 +168,8 @@ double bar_energy(const hmpm::Snapshot& s, double Q) {
   return e;
 }
 
-// The rho_f a term of Darcy's law uses the nodal acceleration of the same
-// step. A saturated bar vibrating freely (closed: no drainage, no load) can
+// The rho_f a term of Darcy's law uses the acceleration of the re-mapped
+// nodal velocities of the same step. A saturated bar vibrating freely (closed: no drainage, no load) can
 // only lose energy to Darcy flow; kinetic + elastic + fluid storage energy
 // must never grow by more than the explicit scheme's O(w dt) oscillation
 // (asserted 2 %), from low to very high permeability where the term
