@@ -355,6 +355,11 @@ class Simulation {
   // buffers in thread order, so sums are reproducible for a thread count.
   enum : unsigned { kMass = 1, kMomentum = 2, kForce = 4, kRemap = 8, kStorage = 16, kPressure = 32, kFlux = 64 };
 
+  /// Nodes [lo, hi] that a thread's particle chunk touches this step.
+  struct NodeRange {
+    std::int64_t lo, hi;
+  };
+
   struct Scatter {
     double* mass;
     Vec* momentum;
@@ -363,64 +368,81 @@ class Simulation {
     double* storage;
     double* pressure;
     double* flux;
+    NodeRange* touched;  ///< set by the step's first phase (particles do not move before the last)
   };
 
+  /// A thread's private nodal sums. Zero outside a phase: the reduction
+  /// that adds them to the grid also clears what it added.
   struct ScatterBuffer {
     std::vector<double> mass, storage, pressure, flux;
     std::vector<Vec> momentum, force, remap;
   };
 
   Scatter scatter_of(int t) {
+    NodeRange* touched = &touched_[static_cast<std::size_t>(t)];
     if (t == 0)
       return {grid_.mass.data(), grid_.momentum.data(), grid_.force.data(), grid_.remap.data(),
-              grid_.storage.data(), grid_.pressure.data(), grid_.flux.data()};
+              grid_.storage.data(), grid_.pressure.data(), grid_.flux.data(), touched};
     ScatterBuffer& b = buffers_[static_cast<std::size_t>(t - 1)];
     return {b.mass.data(), b.momentum.data(), b.force.data(), b.remap.data(),
-            b.storage.data(), b.pressure.data(), b.flux.data()};
+            b.storage.data(), b.pressure.data(), b.flux.data(), touched};
   }
 
   void setup_threads(int threads) {
     pool_ = std::make_unique<ThreadPool>(threads);
     buffers_.resize(static_cast<std::size_t>(threads - 1));
+    touched_.assign(static_cast<std::size_t>(threads), NodeRange{0, grid_.count - 1});
     const auto n = static_cast<std::size_t>(grid_.count);
     for (ScatterBuffer& b : buffers_) {
-      b.mass.resize(n); b.momentum.resize(n); b.force.resize(n); b.remap.resize(n);
-      if (fluid_) { b.storage.resize(n); b.pressure.resize(n); b.flux.resize(n); }
+      b.mass.assign(n, 0.0); b.momentum.assign(n, Vec::Zero()); b.force.assign(n, Vec::Zero());
+      b.remap.assign(n, Vec::Zero());
+      if (fluid_) { b.storage.assign(n, 0.0); b.pressure.assign(n, 0.0); b.flux.assign(n, 0.0); }
     }
   }
 
-  /// Runs phase(scatter, begin, end) over particle chunks, with the private
-  /// buffers of `fields` zeroed first and added to the grid after.
+  /// Runs phase(scatter, begin, end) over particle chunks, then adds the
+  /// private buffers of `fields` to the grid, in thread order, over the
+  /// nodes each thread touched only, clearing them as it goes. Particles
+  /// created in cell order give each thread a band of the grid, so the
+  /// reduction costs about one band per extra thread, not a whole grid.
   template <class Phase>
   void for_particles(unsigned fields, Phase&& phase) {
-    auto chunk = [&](int t, std::size_t b, std::size_t e) {
-      if (t > 0 && fields) {
-        ScatterBuffer& buf = buffers_[static_cast<std::size_t>(t - 1)];
-        if (fields & kMass) std::fill(buf.mass.begin(), buf.mass.end(), 0.0);
-        if (fields & kMomentum) std::fill(buf.momentum.begin(), buf.momentum.end(), Vec::Zero());
-        if (fields & kForce) std::fill(buf.force.begin(), buf.force.end(), Vec::Zero());
-        if (fields & kRemap) std::fill(buf.remap.begin(), buf.remap.end(), Vec::Zero());
-        if (fields & kStorage) std::fill(buf.storage.begin(), buf.storage.end(), 0.0);
-        if (fields & kPressure) std::fill(buf.pressure.begin(), buf.pressure.end(), 0.0);
-        if (fields & kFlux) std::fill(buf.flux.begin(), buf.flux.end(), 0.0);
-      }
-      phase(scatter_of(t), b, e);
-    };
+    auto chunk = [&](int t, std::size_t b, std::size_t e) { phase(scatter_of(t), b, e); };
     pool_->for_ranges(particles_.size(), chunk);
     if (buffers_.empty() || !fields) return;
     auto reduce = [&](int, std::size_t b, std::size_t e) {
-      for (const ScatterBuffer& buf : buffers_)
-        for (std::size_t i = b; i < e; ++i) {
-          if (fields & kMass) grid_.mass[i] += buf.mass[i];
-          if (fields & kMomentum) grid_.momentum[i] += buf.momentum[i];
-          if (fields & kForce) grid_.force[i] += buf.force[i];
-          if (fields & kRemap) grid_.remap[i] += buf.remap[i];
-          if (fields & kStorage) grid_.storage[i] += buf.storage[i];
-          if (fields & kPressure) grid_.pressure[i] += buf.pressure[i];
-          if (fields & kFlux) grid_.flux[i] += buf.flux[i];
+      for (std::size_t t = 1; t < touched_.size(); ++t) {
+        ScatterBuffer& buf = buffers_[t - 1];
+        const auto lo = std::max(b, static_cast<std::size_t>(touched_[t].lo));
+        const auto hi = std::min(e, static_cast<std::size_t>(touched_[t].hi + 1));
+        for (std::size_t i = lo; i < hi; ++i) {
+          if (fields & kMass) { grid_.mass[i] += buf.mass[i]; buf.mass[i] = 0.0; }
+          if (fields & kMomentum) { grid_.momentum[i] += buf.momentum[i]; buf.momentum[i].setZero(); }
+          if (fields & kForce) { grid_.force[i] += buf.force[i]; buf.force[i].setZero(); }
+          if (fields & kRemap) { grid_.remap[i] += buf.remap[i]; buf.remap[i].setZero(); }
+          if (fields & kStorage) { grid_.storage[i] += buf.storage[i]; buf.storage[i] = 0.0; }
+          if (fields & kPressure) { grid_.pressure[i] += buf.pressure[i]; buf.pressure[i] = 0.0; }
+          if (fields & kFlux) { grid_.flux[i] += buf.flux[i]; buf.flux[i] = 0.0; }
         }
+      }
     };
     pool_->for_ranges(static_cast<std::size_t>(grid_.count), reduce);
+  }
+
+  /// Runs f(begin, end) over chunks of the nodes [0, grid count), one per
+  /// thread (node loops whose iterations are independent). Node chunks are
+  /// fixed like particle chunks, and no node loop sums across nodes, so the
+  /// results do not depend on the split.
+  template <class F>
+  void for_nodes(F&& f) {
+    if (!pool_) {  // set-up, before run() starts the threads
+      f(std::int64_t{0}, grid_.count);
+      return;
+    }
+    auto chunk = [&](int, std::size_t b, std::size_t e) {
+      f(static_cast<std::int64_t>(b), static_cast<std::int64_t>(e));
+    };
+    pool_->for_ranges(static_cast<std::size_t>(grid_.count), chunk);
   }
 
   template <bool Grad = true>
@@ -430,15 +452,17 @@ class Simulation {
   }
 
   void clear_grid() {
-    std::fill(grid_.mass.begin(), grid_.mass.end(), 0.0);
-    std::fill(grid_.momentum.begin(), grid_.momentum.end(), Vec::Zero());
-    std::fill(grid_.force.begin(), grid_.force.end(), Vec::Zero());
-    std::fill(grid_.remap.begin(), grid_.remap.end(), Vec::Zero());
-    if (fluid_) {
-      std::fill(grid_.storage.begin(), grid_.storage.end(), 0.0);
-      std::fill(grid_.pressure.begin(), grid_.pressure.end(), 0.0);
-      std::fill(grid_.flux.begin(), grid_.flux.end(), 0.0);
-    }
+    for_nodes([&](std::int64_t b, std::int64_t e) {
+      std::fill(grid_.mass.begin() + b, grid_.mass.begin() + e, 0.0);
+      std::fill(grid_.momentum.begin() + b, grid_.momentum.begin() + e, Vec::Zero());
+      std::fill(grid_.force.begin() + b, grid_.force.begin() + e, Vec::Zero());
+      std::fill(grid_.remap.begin() + b, grid_.remap.begin() + e, Vec::Zero());
+      if (fluid_) {
+        std::fill(grid_.storage.begin() + b, grid_.storage.begin() + e, 0.0);
+        std::fill(grid_.pressure.begin() + b, grid_.pressure.begin() + e, 0.0);
+        std::fill(grid_.flux.begin() + b, grid_.flux.begin() + e, 0.0);
+      }
+    });
   }
 
   /// Total stress divergence term of one particle: f_i -= V sigma grad N_i,
@@ -459,8 +483,11 @@ class Simulation {
   /// fluid storage and storage-weighted pressure, from particles to nodes.
   void map_particles_to_grid(const Scatter& out, std::size_t begin, std::size_t end) {
     StencilT s;
+    NodeRange touched{grid_.count, -1};
     for (std::size_t p = begin; p < end; ++p) {
       stencil_of(p, s);
+      touched.lo = std::min(touched.lo, s.node[0]);  // stencil nodes are in increasing order
+      touched.hi = std::max(touched.hi, s.node[StencilT::N - 1]);
       const double m = particles_.mass[p];
       const double vol = particles_.volume[p];
       const Vec mv = m * particles_.v[p];
@@ -485,13 +512,16 @@ class Simulation {
         }
       }
     }
+    *out.touched = touched;
   }
 
   /// Nodal pressure = storage-weighted average of particle pressures, then
   /// prescribed values at time t.
   void compute_nodal_pressure(double t) {
-    for (std::int64_t i = 0; i < grid_.count; ++i)
-      grid_.pressure[i] = grid_.storage[i] > 0 ? grid_.pressure[i] / grid_.storage[i] : 0.0;
+    for_nodes([&](std::int64_t b, std::int64_t e) {
+      for (std::int64_t i = b; i < e; ++i)
+        grid_.pressure[i] = grid_.storage[i] > 0 ? grid_.pressure[i] / grid_.storage[i] : 0.0;
+    });
     for (const PressureConstraint& bc : pressure_bcs_) {
       const double value = (*bc.fn)(t);
       for (std::int64_t i : bc.nodes) grid_.pressure[i] = value;
@@ -538,21 +568,23 @@ class Simulation {
   /// nodal acceleration used by the particles.
   void update_nodal_momentum(double t, double dt) {
     const double alpha = damping_;
-    for (std::int64_t i = 0; i < grid_.count; ++i) {
-      const double m = grid_.mass[i];
-      if (m <= mass_tolerance_) {
-        grid_.velocity[i].setZero();
-        grid_.accel[i].setZero();
-        continue;
+    for_nodes([&](std::int64_t b, std::int64_t e) {
+      for (std::int64_t i = b; i < e; ++i) {
+        const double m = grid_.mass[i];
+        if (m <= mass_tolerance_) {
+          grid_.velocity[i].setZero();
+          grid_.accel[i].setZero();
+          continue;
+        }
+        Vec f = grid_.force[i];
+        const Vec v0 = grid_.momentum[i] / m;
+        if (alpha > 0)
+          for (int a = 0; a < Dim; ++a)
+            f[a] -= alpha * std::abs(f[a]) * (v0[a] > 0 ? 1.0 : (v0[a] < 0 ? -1.0 : 0.0));
+        grid_.accel[i] = f / m;
+        grid_.velocity[i] = v0 + dt * grid_.accel[i];
       }
-      Vec f = grid_.force[i];
-      const Vec v0 = grid_.momentum[i] / m;
-      if (alpha > 0)
-        for (int a = 0; a < Dim; ++a)
-          f[a] -= alpha * std::abs(f[a]) * (v0[a] > 0 ? 1.0 : (v0[a] < 0 ? -1.0 : 0.0));
-      grid_.accel[i] = f / m;
-      grid_.velocity[i] = v0 + dt * grid_.accel[i];
-    }
+    });
     for (const RigidTie& tie : rigid_ties_)
       for (int a = 0; a < Dim; ++a) {
         if (!tie.axes[a]) continue;
@@ -662,10 +694,12 @@ class Simulation {
         }
         tie.remapped[a] = mass > 0.0 ? momentum / mass : 0.0;
       }
-    for (std::int64_t i = 0; i < grid_.count; ++i) {
-      const double m = grid_.mass[i];
-      grid_.remap[i] = m > mass_tolerance_ ? Vec(grid_.remap[i] / m) : Vec::Zero();
-    }
+    for_nodes([&](std::int64_t b, std::int64_t e) {
+      for (std::int64_t i = b; i < e; ++i) {
+        const double m = grid_.mass[i];
+        grid_.remap[i] = m > mass_tolerance_ ? Vec(grid_.remap[i] / m) : Vec::Zero();
+      }
+    });
     for (const RigidTie& tie : rigid_ties_)
       for (int a = 0; a < Dim; ++a) {
         if (!tie.axes[a]) continue;
@@ -691,13 +725,16 @@ class Simulation {
     // diffusion that balances it (docs/verification.md). Prescribed and
     // rigid components keep the acceleration of update_nodal_momentum.
     const double inv_dt = 1.0 / dt;
-    for (std::int64_t i = 0; i < grid_.count; ++i) {
-      const double m = grid_.mass[i];
-      if (m <= mass_tolerance_) continue;
-      const std::uint8_t fixed = prescribed_axes_[static_cast<std::size_t>(i)];
-      for (int a = 0; a < Dim; ++a)
-        if (!(fixed & (1u << a))) grid_.accel[i][a] = (grid_.remap[i][a] - grid_.momentum[i][a] / m) * inv_dt;
-    }
+    for_nodes([&](std::int64_t b, std::int64_t e) {
+      for (std::int64_t i = b; i < e; ++i) {
+        const double m = grid_.mass[i];
+        if (m <= mass_tolerance_) continue;
+        const std::uint8_t fixed = prescribed_axes_[static_cast<std::size_t>(i)];
+        for (int a = 0; a < Dim; ++a)
+          if (!(fixed & (1u << a)))
+            grid_.accel[i][a] = (grid_.remap[i][a] - grid_.momentum[i][a] / m) * inv_dt;
+      }
+    });
   }
 
   /// Phase 4: strain increment from the re-mapped nodal velocities, stress
@@ -756,8 +793,10 @@ class Simulation {
   /// Grid: ds p/dt from the scattered flux; free nodes advance, prescribed
   /// nodes take their value at t + dt.
   void update_nodal_pressure(double t_new, double dt) {
-    for (std::int64_t i = 0; i < grid_.count; ++i)
-      grid_.dp[i] = grid_.storage[i] > 0 ? dt * grid_.flux[i] / grid_.storage[i] : 0.0;
+    for_nodes([&](std::int64_t b, std::int64_t e) {
+      for (std::int64_t i = b; i < e; ++i)
+        grid_.dp[i] = grid_.storage[i] > 0 ? dt * grid_.flux[i] / grid_.storage[i] : 0.0;
+    });
     for (const PressureConstraint& bc : pressure_bcs_) {
       const double value = (*bc.fn)(t_new);
       for (std::int64_t i : bc.nodes) grid_.dp[i] = value - grid_.pressure[i];
@@ -910,6 +949,7 @@ class Simulation {
 
   std::unique_ptr<ThreadPool> pool_;
   std::vector<ScatterBuffer> buffers_;
+  std::vector<NodeRange> touched_;  ///< per thread, from the step's first phase
 
   std::mutex failure_mutex_;
   double damping_ = 0.0;  // local damping coefficient of the current step
