@@ -479,8 +479,9 @@ class Simulation {
     return m;
   }
 
-  /// Phase 1: mass, momentum, effective-stress and body forces, and the
-  /// fluid storage and storage-weighted pressure, from particles to nodes.
+  /// Phase 1: mass, momentum and effective-stress forces, and the fluid
+  /// storage and storage-weighted pressure, from particles to nodes. (The
+  /// body force sum_p N_ip m_p g is m_i g: update_nodal_momentum adds it.)
   void map_particles_to_grid(const Scatter& out, std::size_t begin, std::size_t end) {
     StencilT s;
     NodeRange touched{grid_.count, -1};
@@ -491,14 +492,13 @@ class Simulation {
       const double m = particles_.mass[p];
       const double vol = particles_.volume[p];
       const Vec mv = m * particles_.v[p];
-      const Vec mb = m * gravity_;
       const Mat vol_sig = vol * active_stress(particles_.stress[p]);
       for (int k = 0; k < StencilT::N; ++k) {
         const std::int64_t i = s.node[k];
         const double w = s.w[k];
         out.mass[i] += w * m;
         out.momentum[i] += w * mv;
-        out.force[i] += w * mb - vol_sig * s.grad[k];
+        out.force[i].noalias() -= vol_sig * s.grad[k];
       }
       if (fluid_) {
         const std::uint16_t mat = particles_.material[p];
@@ -563,8 +563,8 @@ class Simulation {
     }
   }
 
-  /// Grid update: momentum += dt f (with local damping), then prescribed
-  /// velocities at t + dt. Gives the Lagrangian nodal velocity and the
+  /// Grid update: momentum += dt (f + m g) (with local damping), then
+  /// prescribed velocities at t + dt. Gives the Lagrangian nodal velocity and the
   /// nodal acceleration used by the particles.
   void update_nodal_momentum(double t, double dt) {
     const double alpha = damping_;
@@ -576,7 +576,7 @@ class Simulation {
           grid_.accel[i].setZero();
           continue;
         }
-        Vec f = grid_.force[i];
+        Vec f = grid_.force[i] + m * gravity_;
         const Vec v0 = grid_.momentum[i] / m;
         if (alpha > 0)
           for (int a = 0; a < Dim; ++a)
@@ -778,10 +778,15 @@ class Simulation {
       const double tr = de[0] + de[1] + de[2];
       Voigt& sig = particles_.stress[p];
       if constexpr (Dim >= 2) rotate_jaumann<Dim>(sig, grad_v, dt);
-      for (int c = 0; c < 3; ++c) sig[c] += mc.lambda * tr + 2.0 * mc.shear_modulus * de[c];
-      for (int c = 3; c < 6; ++c) sig[c] += 2.0 * mc.shear_modulus * de[c];
+      // Constants copied first: the stores to sig could alias mc for the compiler.
+      const double lambda_tr = mc.lambda * tr, two_g = 2.0 * mc.shear_modulus;
+      // Below 3D the strain components yz, zx (and zz, 1D: all shear) stay
+      // zero: only the components an increment can change are touched.
+      constexpr int kShear = Dim == 1 ? 3 : (Dim == 2 ? 4 : 6);
+      for (int c = 0; c < 3; ++c) sig[c] += lambda_tr + two_g * de[c];
+      for (int c = 3; c < kShear; ++c) sig[c] += two_g * de[c];
       if constexpr (Plastic) return_to_yield_surface(sig, mc);
-      particles_.strain[p] += de;
+      for (int c = 0; c < kShear; ++c) particles_.strain[p][c] += de[c];
       const double j = (Mat::Identity() + dt * grad_v).determinant();
       if (!(j > 0.0)) fail_volume(p, j);
       particles_.volume[p] = vol * j;
@@ -824,18 +829,26 @@ class Simulation {
     }
   }
 
+  /// Moves the particle with the Lagrangian nodal velocity. One test per
+  /// axis catches both failures: a non-finite position (the comparisons are
+  /// false for NaN) and a position outside the grid. A non-finite particle
+  /// velocity, stress or force makes the nodal velocities, hence the
+  /// position, non-finite in the same or the next step.
   __attribute__((always_inline)) inline void move_particle(std::size_t p, const StencilT& s, double dt) {
     Vec dx = Vec::Zero();
     for (int k = 0; k < StencilT::N; ++k) dx += s.w[k] * grid_.velocity[s.node[k]];
     dx *= dt;
-    particles_.x[p] += dx;
+    Vec& x = particles_.x[p];
+    x += dx;
     particles_.u[p] += dx;
-    if (!particles_.x[p].allFinite() || !particles_.v[p].allFinite()) {
-      fail_nonfinite(p, "velocity");
-      return;
+    bool inside = true;
+    for (int a = 0; a < Dim; ++a) inside &= (x[a] >= grid_.origin[a]) & (x[a] <= grid_max_[a]);
+    if (!inside) [[unlikely]] {
+      if (!x.allFinite() || !particles_.v[p].allFinite())
+        fail_nonfinite(p, "velocity");
+      else
+        fail_left_grid(p);
     }
-    for (int a = 0; a < Dim; ++a)
-      if (particles_.x[p][a] < grid_.origin[a] || particles_.x[p][a] > grid_max_[a]) fail_left_grid(p);
   }
 
   /// Plastic correction of the elastic trial stress (effective stress, so
