@@ -131,6 +131,7 @@ class Simulation {
           for (double x : layout.coords[0]) {
             const Vec3 x3{x, y, z};
             for (int a = 0; a < Dim; ++a) particles_.x[p][a] = x3[a];
+            particles_.x0[p] = particles_.x[p];
             particles_.volume[p] = v0;
             particles_.mass[p] = mc.mixture_density * v0;
             particles_.material[p] = static_cast<std::uint16_t>(body.material);
@@ -840,7 +841,6 @@ class Simulation {
     dx *= dt;
     Vec& x = particles_.x[p];
     x += dx;
-    particles_.u[p] += dx;
     bool inside = true;
     for (int a = 0; a < Dim; ++a) inside &= (x[a] >= grid_.origin[a]) & (x[a] <= grid_max_[a]);
     if (!inside) [[unlikely]] {

@@ -29,7 +29,12 @@ void Simulation<Dim, Shape>::fill_snapshot(Snapshot& snap, const std::vector<Fie
   for (Field f : fields) {
     switch (f) {
       case Field::position: vec3(snap.position, particles_.x); break;
-      case Field::displacement: vec3(snap.displacement, particles_.u); break;
+      case Field::displacement: {
+        snap.displacement.assign(3 * n, 0.0);
+        for (std::size_t p = 0; p < n; ++p)
+          for (int a = 0; a < Dim; ++a) snap.displacement[3 * p + a] = particles_.x[p][a] - particles_.x0[p][a];
+        break;
+      }
       case Field::velocity: vec3(snap.velocity, particles_.v); break;
       case Field::darcy_velocity: vec3(snap.darcy_velocity, particles_.darcy); break;
       case Field::pore_pressure: scalar(snap.pore_pressure, particles_.pressure_out); break;
@@ -59,7 +64,9 @@ void Simulation<Dim, Shape>::sample_series(Series& series, double t) const {
       const auto p = static_cast<std::size_t>(pi);
       switch (series.fields[f]) {
         case Field::position: for (int a = 0; a < Dim; ++a) out.push_back(particles_.x[p][a]); break;
-        case Field::displacement: for (int a = 0; a < Dim; ++a) out.push_back(particles_.u[p][a]); break;
+        case Field::displacement:
+          for (int a = 0; a < Dim; ++a) out.push_back(particles_.x[p][a] - particles_.x0[p][a]);
+          break;
         case Field::velocity: for (int a = 0; a < Dim; ++a) out.push_back(particles_.v[p][a]); break;
         case Field::darcy_velocity:
           for (int a = 0; a < Dim; ++a) out.push_back(particles_.darcy.empty() ? 0.0 : particles_.darcy[p][a]);

@@ -22,7 +22,7 @@ template <int Dim>
 struct ParticleState {
   using Vec = VecD<Dim>;
   std::vector<Vec> x;         ///< position, m
-  std::vector<Vec> u;         ///< displacement from the initial position, m
+  std::vector<Vec> x0;        ///< initial position, m (displacement = x - x0; not touched by the step)
   std::vector<Vec> v;         ///< velocity, m/s
   std::vector<double> mass;   ///< kg (per unit area in 1D, per unit thickness in 2D); constant
   std::vector<double> volume; ///< current volume, m^3 (per unit area / thickness)
@@ -40,7 +40,7 @@ struct ParticleState {
   std::size_t size() const { return x.size(); }
 
   void resize(std::size_t n, bool fluid, bool gimp) {
-    x.resize(n); u.assign(n, Vec::Zero()); v.assign(n, Vec::Zero());
+    x.resize(n); x0.resize(n); v.assign(n, Vec::Zero());
     mass.resize(n); volume.resize(n);
     stress.assign(n, Voigt::Zero()); strain.assign(n, Voigt::Zero());
     material.resize(n);
