@@ -104,12 +104,16 @@ struct Stencil {
   static constexpr int N = Dim == 1 ? K : (Dim == 2 ? K * K : K * K * K);
   std::array<std::int64_t, N> node{};
   std::array<double, N> w{};
-  std::array<Eigen::Matrix<double, Dim, 1>, N> grad;
+  /// dN/dx_a of the N nodes, one array per axis (structure of arrays, so the
+  /// products below vectorise across nodes). Zeroed once per phase (not per
+  /// particle): weights-only passes leave them untouched.
+  std::array<std::array<double, N>, Dim> dw{};
 
-  // Zeroed once per phase (not per particle): weights-only passes leave the
-  // gradients untouched, and Eigen types are not value-initialised.
-  Stencil() {
-    for (auto& g : grad) g.setZero();
+  /// Gradient of node k's shape function.
+  Eigen::Matrix<double, Dim, 1> grad(int k) const {
+    Eigen::Matrix<double, Dim, 1> g;
+    for (int a = 0; a < Dim; ++a) g[a] = dw[a][k];
+    return g;
   }
 
   /// x: particle position; origin, inv_h: grid; cells, stride: per axis.
@@ -129,7 +133,7 @@ struct Stencil {
       for (int i = 0; i < K; ++i) {
         node[i] = base[0] + i;
         w[i] = wa[0][i];
-        if constexpr (Grad) grad[i][0] = da[0][i];
+        if constexpr (Grad) dw[0][i] = da[0][i];
       }
     } else if constexpr (Dim == 2) {
       const std::int64_t node0 = base[0] + base[1] * stride[1];
@@ -140,8 +144,8 @@ struct Stencil {
           node[n] = row + i;
           w[n] = wa[0][i] * wa[1][j];
           if constexpr (Grad) {
-            grad[n][0] = da[0][i] * wa[1][j];
-            grad[n][1] = wa[0][i] * da[1][j];
+            dw[0][n] = da[0][i] * wa[1][j];
+            dw[1][n] = wa[0][i] * da[1][j];
           }
         }
       }
@@ -158,9 +162,9 @@ struct Stencil {
             node[n] = row + i;
             w[n] = wa[0][i] * wjk;
             if constexpr (Grad) {
-              grad[n][0] = da[0][i] * wjk;
-              grad[n][1] = wa[0][i] * djk;
-              grad[n][2] = wa[0][i] * wdk;
+              dw[0][n] = da[0][i] * wjk;
+              dw[1][n] = wa[0][i] * djk;
+              dw[2][n] = wa[0][i] * wdk;
             }
           }
         }

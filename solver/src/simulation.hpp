@@ -499,7 +499,7 @@ class Simulation {
         const double w = s.w[k];
         out.mass[i] += w * m;
         out.momentum[i] += w * mv;
-        out.force[i].noalias() -= vol_sig * s.grad[k];
+        out.force[i].noalias() -= vol_sig * s.grad(k);
       }
       if (fluid_) {
         const std::uint16_t mat = particles_.material[p];
@@ -540,7 +540,7 @@ class Simulation {
       for (int k = 0; k < StencilT::N; ++k) p_hat += s.w[k] * grid_.pressure[s.node[k]];
       const double vp = particles_.volume[p] * p_hat;
       for (int k = 0; k < StencilT::N; ++k)
-        out.force[s.node[k]] += vp * s.grad[k];
+        out.force[s.node[k]] += vp * s.grad(k);
     }
   }
 
@@ -751,7 +751,7 @@ class Simulation {
       stencil_of(p, s);
       Mat grad_v = Mat::Zero();
       for (int k = 0; k < StencilT::N; ++k)
-        grad_v.noalias() += grid_.remap[s.node[k]] * s.grad[k].transpose();
+        grad_v.noalias() += grid_.remap[s.node[k]] * s.grad(k).transpose();
       const double vol = particles_.volume[p];
       const std::uint16_t mat = particles_.material[p];
       const MaterialConstants& mc = constants_[mat];
@@ -759,7 +759,7 @@ class Simulation {
         const double div_v = grad_v.trace();
         Vec grad_p = Vec::Zero(), a = Vec::Zero();
         for (int k = 0; k < StencilT::N; ++k) {
-          grad_p += grid_.pressure[s.node[k]] * s.grad[k];
+          grad_p += grid_.pressure[s.node[k]] * s.grad(k);
           a += s.w[k] * grid_.accel[s.node[k]];
         }
         const Vec w = -mc.permeability_over_gamma *
@@ -767,7 +767,7 @@ class Simulation {
         particles_.darcy[p] = w;
         for (int k = 0; k < StencilT::N; ++k)
           out.flux[s.node[k]] +=
-              vol * (s.grad[k].dot(w) - s.w[k] * div_v);
+              vol * (s.grad(k).dot(w) - s.w[k] * div_v);
       }
       Voigt de = Voigt::Zero();
       for (int a = 0; a < Dim; ++a) de[a] = grad_v(a, a) * dt;
