@@ -2,12 +2,12 @@
 # bench/run.sh — runs the benchmark matrix and rewrites the measured part of
 # docs/performance.md (between the bench:begin and bench:end markers).
 #
-#   bash bench/run.sh            # full matrix (about 10 minutes on 2 vCPU)
+#   bash bench/run.sh            # full matrix (about 15 minutes on 2 vCPU)
 #   bash bench/run.sh --quick    # a few rows, to check the script itself
 #   bash bench/run.sh --no-doc   # print the table, leave the doc alone
 #
 # Benchmarks, not tests: nothing here asserts a time. Run on a quiet machine;
-# every row is the best of REPEAT runs (default 2) to shave off interference.
+# every row is the best of REPEAT runs (default 3) to shave off interference.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install-deps.sh >/dev/null  # wrk, valgrind, the build tools
@@ -23,7 +23,7 @@ for arg in "$@"; do
     *) echo "usage: bench/run.sh [--quick] [--no-doc]" >&2; exit 2 ;;
   esac
 done
-repeat=${REPEAT:-2}
+repeat=${REPEAT:-3}
 build=${BUILD_DIR:-build-bench}
 
 cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=Release -DHMPM_BUILD_TESTS=OFF >/dev/null
@@ -124,7 +124,9 @@ machine() {
   local cpu
   cpu=$(sed -n 's/^model name[[:space:]]*: //p' /proc/cpuinfo | head -1)
   echo "- Machine: $(nproc) vCPU, $cpu, $(awk '/MemTotal/ {printf "%.0f GiB", $2 / 1048576}' /proc/meminfo) RAM"
-  echo "- Compiler: $(c++ --version | head -1); Release (-O3, no -march=native)"
+  local march
+  march=$(grep -o -- '-march=[^ ]*' "$build/solver/CMakeFiles/hmpm_solver.dir/flags.make" | head -1)
+  echo "- Compiler: $(c++ --version | head -1); Release (-O3 ${march:-no -march}; HMPM_ARCH=$(sed -n 's/^HMPM_ARCH:STRING=//p' "$build/CMakeCache.txt"))"
   echo "- Commit: $(git rev-parse --short HEAD)$(git diff --quiet HEAD -- solver bench || echo ' (with local changes)'); measured $(date -u '+%Y-%m-%d %H:%M UTC')"
   echo "- Command: \`bash bench/run.sh\` (best of $repeat runs per row; the time loop only, as in summary.json)"
 }
