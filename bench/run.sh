@@ -24,6 +24,7 @@ for arg in "$@"; do
   esac
 done
 repeat=${REPEAT:-3}
+pairs=${PAIRS:-5}
 build=${BUILD_DIR:-build-bench}
 
 cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=Release -DHMPM_BUILD_TESTS=OFF >/dev/null
@@ -92,20 +93,6 @@ table() {
       row "3D $kind linear" --dim 3 --nb "$nb" --steps "$(steps_for $n)" --threads 1 $coupled
     done
   done
-  # Two threads at 400k particles (the quick run uses its single size).
-  local nb2=${nb2d[2]:-${nb2d[0]}} nb3=${nb3d[2]:-${nb3d[0]}}
-  for coupled in "" "--coupled"; do
-    local kind=dry
-    [[ -n $coupled ]] && kind=coupled
-    for t in 1 2; do
-      # shellcheck disable=SC2086
-      row "2D $kind linear" --dim 2 --nb "$nb2" --steps "$(steps_for $((4 * nb2 * nb2)))" --threads $t $coupled
-    done
-    for t in 1 2; do
-      # shellcheck disable=SC2086
-      row "3D $kind linear" --dim 3 --nb "$nb3" --steps "$(steps_for $((8 * nb3 * nb3 * nb3)))" --threads $t $coupled
-    done
-  done
   # Shape functions at about 100k particles.
   local nbs=${nb2d[1]:-${nb2d[0]}} nbs3=${nb3d[1]:-${nb3d[0]}}
   for shape in gimp bspline; do
@@ -117,6 +104,45 @@ table() {
       # shellcheck disable=SC2086
       row "3D $kind $shape" --dim 3 --nb "$nbs3" --steps "$(steps_for $((8 * nbs3 * nbs3 * nbs3)))" --threads 1 --shape $shape $coupled
     done
+  done
+}
+
+# Two threads against one: runs alternate (1, 2, 1, 2, ...) so that both see
+# the same machine state, and the speed-up is the median of the per-pair
+# ratios over $pairs pairs; the throughputs are the best of each.
+pair() {
+  local label=$1
+  shift
+  local ratios=() best1=0 best2=0 out1 out2 p1 p2 particles
+  for ((r = 0; r < pairs; ++r)); do
+    out1=$("$bench" "$@" --threads 1)
+    out2=$("$bench" "$@" --threads 2)
+    p1=$(value particle_steps_per_second <<<"$out1")
+    p2=$(value particle_steps_per_second <<<"$out2")
+    ratios+=("$(awk -v a="$p2" -v b="$p1" 'BEGIN{printf "%.2f", a / b}')")
+    best1=$(awk -v a="$p1" -v b="$best1" 'BEGIN{print (a > b) ? a : b}')
+    best2=$(awk -v a="$p2" -v b="$best2" 'BEGIN{print (a > b) ? a : b}')
+  done
+  particles=$(value particles <<<"$out1")
+  local median
+  median=$(printf '%s\n' "${ratios[@]}" | sort -g | awk '{v[NR] = $1} END {print (NR % 2) ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2}')
+  printf '| %s | %s | %.2f M | %.2f M | %.2f× (%s) |\n' "$label" "$particles" \
+    "$(awk -v v="$best1" 'BEGIN{print v / 1e6}')" "$(awk -v v="$best2" 'BEGIN{print v / 1e6}')" \
+    "$median" "$(IFS=' '; echo "${ratios[*]}")"
+}
+
+threads_table() {
+  echo '| case | particles | 1 thread | 2 threads | speed-up: median of pairs (each pair) |'
+  echo '|---|---:|---:|---:|---:|'
+  # 400k particles (the quick run uses its single size).
+  local nb2=${nb2d[2]:-${nb2d[0]}} nb3=${nb3d[2]:-${nb3d[0]}}
+  for coupled in "" "--coupled"; do
+    local kind=dry
+    [[ -n $coupled ]] && kind=coupled
+    # shellcheck disable=SC2086
+    pair "2D $kind linear" --dim 2 --nb "$nb2" --steps "$(steps_for $((4 * nb2 * nb2)))" $coupled
+    # shellcheck disable=SC2086
+    pair "3D $kind linear" --dim 3 --nb "$nb3" --steps "$(steps_for $((8 * nb3 * nb3 * nb3)))" $coupled
   done
 }
 
@@ -135,6 +161,10 @@ result=$(
   machine
   echo
   table
+  echo
+  echo "Two threads (alternating runs, $pairs pairs per row):"
+  echo
+  threads_table
 )
 echo "$result"
 
