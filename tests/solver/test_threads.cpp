@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 
 #include "hmpm/run.hpp"
 #include "problems.hpp"
@@ -71,6 +72,8 @@ TEST(Threads, TwoThreadsAgreeWithOneAndAreDeterministic) {
       ASSERT_EQ(one.size(), many.size());
       double worst = 0;
       for (std::size_t i = 0; i < one.size(); ++i) worst = std::max(worst, std::abs(one[i] - many[i]));
+      std::printf("threads: %d against 1, largest difference %.2e of the largest value\n", threads,
+                  worst / scale);
       EXPECT_LT(worst, 1e-9 * scale) << threads << " threads";
       EXPECT_EQ(many, again) << threads << " threads";
     }
