@@ -781,13 +781,13 @@ class Simulation {
       if constexpr (Dim >= 2) rotate_jaumann<Dim>(sig, grad_v, dt);
       // Constants copied first: the stores to sig could alias mc for the compiler.
       const double lambda_tr = mc.lambda * tr, two_g = 2.0 * mc.shear_modulus;
-      // Below 3D the strain components yz, zx (and zz, 1D: all shear) stay
-      // zero: only the components an increment can change are touched.
-      constexpr int kShear = Dim == 1 ? 3 : (Dim == 2 ? 4 : 6);
+      // Below 3D the shear increments yz and zx (in 1D also xy) are zero:
+      // the loops end before them (components 0..kEnd-1 can change).
+      constexpr int kEnd = Dim == 1 ? 3 : (Dim == 2 ? 4 : 6);
       for (int c = 0; c < 3; ++c) sig[c] += lambda_tr + two_g * de[c];
-      for (int c = 3; c < kShear; ++c) sig[c] += two_g * de[c];
+      for (int c = 3; c < kEnd; ++c) sig[c] += two_g * de[c];
       if constexpr (Plastic) return_to_yield_surface(sig, mc);
-      for (int c = 0; c < kShear; ++c) particles_.strain[p][c] += de[c];
+      for (int c = 0; c < kEnd; ++c) particles_.strain[p][c] += de[c];
       const double j = (Mat::Identity() + dt * grad_v).determinant();
       if (!(j > 0.0)) fail_volume(p, j);
       particles_.volume[p] = vol * j;
