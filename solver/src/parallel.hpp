@@ -8,8 +8,16 @@
 // given thread count. Dispatch costs a few microseconds per phase and
 // allocates nothing; the job is passed as a function pointer and a context
 // pointer, not a std::function.
+//
+// Phases whose result does not depend on which thread handles which index
+// (no sums across particles) use `for_blocks(n, block, f)` instead: the
+// threads take blocks of `block` indices from a shared counter until none is
+// left, so a thread on a slower (shared, virtual) CPU takes fewer blocks
+// instead of making the other one wait.
 #pragma once
 
+#include <algorithm>
+#include <atomic>
 #include <condition_variable>
 #include <cstddef>
 #include <mutex>
@@ -44,6 +52,20 @@ class ThreadPool {
   /// Runs f(thread, begin, end) on every chunk of [0, n); returns when all are done.
   template <class F>
   void for_ranges(std::size_t n, F& f) {
+    dispatch(n, 0, f);
+  }
+
+  /// Runs f(thread, begin, end) on blocks [k block, (k + 1) block) of [0, n),
+  /// each block once, on whichever thread is free; returns when all are done.
+  template <class F>
+  void for_blocks(std::size_t n, std::size_t block, F& f) {
+    dispatch(n, std::max<std::size_t>(block, 1), f);
+  }
+
+ private:
+  /// block == 0: one fixed chunk per thread; otherwise blocks from next_.
+  template <class F>
+  void dispatch(std::size_t n, std::size_t block, F& f) {
     if (size_ == 1) {
       f(0, std::size_t{0}, n);
       return;
@@ -53,16 +75,30 @@ class ThreadPool {
       job_ = &trampoline<F>;
       context_ = &f;
       n_ = n;
+      block_ = block;
+      next_.store(0, std::memory_order_relaxed);  // published by the mutex
       pending_ = size_ - 1;
       ++generation_;
     }
     wake_.notify_all();
-    f(0, std::size_t{0}, chunk_begin(n, 1));
+    run(0, &trampoline<F>, &f, n, block);
     std::unique_lock<std::mutex> lock(mutex_);
     done_.wait(lock, [this] { return pending_ == 0; });
   }
 
- private:
+  void run(int t, void (*job)(void*, int, std::size_t, std::size_t), void* context, std::size_t n,
+           std::size_t block) {
+    if (block == 0) {
+      job(context, t, chunk_begin(n, t), chunk_begin(n, t + 1));
+      return;
+    }
+    for (;;) {
+      const std::size_t begin = next_.fetch_add(block, std::memory_order_relaxed);
+      if (begin >= n) return;
+      job(context, t, begin, std::min(n, begin + block));
+    }
+  }
+
   template <class F>
   static void trampoline(void* context, int t, std::size_t begin, std::size_t end) {
     (*static_cast<F*>(context))(t, begin, end);
@@ -73,7 +109,7 @@ class ThreadPool {
     for (;;) {
       void (*job)(void*, int, std::size_t, std::size_t);
       void* context;
-      std::size_t n;
+      std::size_t n, block;
       {
         std::unique_lock<std::mutex> lock(mutex_);
         wake_.wait(lock, [&] { return generation_ != seen; });
@@ -82,8 +118,9 @@ class ThreadPool {
         job = job_;
         context = context_;
         n = n_;
+        block = block_;
       }
-      job(context, t, chunk_begin(n, t), chunk_begin(n, t + 1));
+      run(t, job, context, n, block);
       {
         std::lock_guard<std::mutex> lock(mutex_);
         if (--pending_ == 0) done_.notify_one();
@@ -100,6 +137,8 @@ class ThreadPool {
   void (*job_)(void*, int, std::size_t, std::size_t) = nullptr;
   void* context_ = nullptr;
   std::size_t n_ = 0;
+  std::size_t block_ = 0;
+  std::atomic<std::size_t> next_{0};  ///< first index of the next free block (for_blocks)
   int pending_ = 0;
 };
 

@@ -406,17 +406,31 @@ class Simulation {
   /// nodes each thread touched only, clearing them as it goes. Particles
   /// created in cell order give each thread a band of the grid, so the
   /// reduction costs about one band per extra thread, not a whole grid.
+  /// Phases that scatter nothing (fields == 0) give each particle's result
+  /// regardless of the thread that computes it: they take blocks
+  /// dynamically, so a slower virtual CPU does less of the work.
   template <class Phase>
   void for_particles(unsigned fields, Phase&& phase) {
     auto chunk = [&](int t, std::size_t b, std::size_t e) { phase(scatter_of(t), b, e); };
+    if (!fields) {
+      pool_->for_blocks(particles_.size(), block_of(particles_.size(), kParticleBlock), chunk);
+      return;
+    }
     pool_->for_ranges(particles_.size(), chunk);
-    if (buffers_.empty() || !fields) return;
+    if (buffers_.empty()) return;
+    // Every node of the buffers' bands, split over the threads.
+    std::int64_t lo = grid_.count, hi = -1;
+    for (std::size_t t = 1; t < touched_.size(); ++t) {
+      lo = std::min(lo, touched_[t].lo);
+      hi = std::max(hi, touched_[t].hi);
+    }
+    if (hi < lo) return;
     auto reduce = [&](int, std::size_t b, std::size_t e) {
       for (std::size_t t = 1; t < touched_.size(); ++t) {
         ScatterBuffer& buf = buffers_[t - 1];
-        const auto lo = std::max(b, static_cast<std::size_t>(touched_[t].lo));
-        const auto hi = std::min(e, static_cast<std::size_t>(touched_[t].hi + 1));
-        for (std::size_t i = lo; i < hi; ++i) {
+        const auto first = std::max(b, static_cast<std::size_t>(touched_[t].lo));
+        const auto last = std::min(e, static_cast<std::size_t>(touched_[t].hi + 1));
+        for (std::size_t i = first; i < last; ++i) {
           if (fields & kMass) { grid_.mass[i] += buf.mass[i]; buf.mass[i] = 0.0; }
           if (fields & kMomentum) { grid_.momentum[i] += buf.momentum[i]; buf.momentum[i].setZero(); }
           if (fields & kForce) { grid_.force[i] += buf.force[i]; buf.force[i].setZero(); }
@@ -427,13 +441,16 @@ class Simulation {
         }
       }
     };
-    pool_->for_ranges(static_cast<std::size_t>(grid_.count), reduce);
+    const auto offset = static_cast<std::size_t>(lo);
+    auto band = [&](int t, std::size_t b, std::size_t e) { reduce(t, offset + b, offset + e); };
+    const auto nodes = static_cast<std::size_t>(hi - lo + 1);
+    pool_->for_blocks(nodes, block_of(nodes, kNodeBlock), band);
   }
 
-  /// Runs f(begin, end) over chunks of the nodes [0, grid count), one per
-  /// thread (node loops whose iterations are independent). Node chunks are
-  /// fixed like particle chunks, and no node loop sums across nodes, so the
-  /// results do not depend on the split.
+  /// Runs f(begin, end) over blocks of the nodes [0, grid count), taken by
+  /// the threads dynamically (node loops whose iterations are independent:
+  /// no node loop sums across nodes, so the results do not depend on the
+  /// split).
   template <class F>
   void for_nodes(F&& f) {
     if (!pool_) {  // set-up, before run() starts the threads
@@ -443,7 +460,16 @@ class Simulation {
     auto chunk = [&](int, std::size_t b, std::size_t e) {
       f(static_cast<std::int64_t>(b), static_cast<std::int64_t>(e));
     };
-    pool_->for_ranges(static_cast<std::size_t>(grid_.count), chunk);
+    const auto nodes = static_cast<std::size_t>(grid_.count);
+    pool_->for_blocks(nodes, block_of(nodes, kNodeBlock), chunk);
+  }
+
+  /// Block sizes of dynamically shared loops: at most a few hundred
+  /// microseconds of work, and at least 16 blocks per thread, so the faster
+  /// thread can take up the slack (small runs get small blocks).
+  static constexpr std::size_t kParticleBlock = 4096, kNodeBlock = 8192;
+  std::size_t block_of(std::size_t n, std::size_t largest) const {
+    return std::clamp<std::size_t>(n / (16 * static_cast<std::size_t>(pool_->size())), 64, largest);
   }
 
   template <bool Grad = true>
