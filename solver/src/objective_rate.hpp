@@ -14,10 +14,14 @@
 namespace hmpm {
 
 /// Adds the Jaumann rotation over one step to the Voigt stress s
-/// (xx, yy, zz, xy, yz, zx). 1D has no spin: nothing to do.
+/// (xx, yy, zz, xy, yz, zx). 1D has no spin: nothing to do. Always inlined:
+/// GCC 12 kept the 3D version out of line, which sends the stress through
+/// memory at every particle (callgrind, 3D dry: 1328 -> 1294 instructions per
+/// particle-step).
 template <int Dim>
-inline void rotate_jaumann(Eigen::Matrix<double, 6, 1>& s,
-                           const Eigen::Matrix<double, Dim, Dim>& grad_v, double dt) {
+__attribute__((always_inline)) inline void rotate_jaumann(Eigen::Matrix<double, 6, 1>& s,
+                                                          const Eigen::Matrix<double, Dim, Dim>& grad_v,
+                                                          double dt) {
   if constexpr (Dim == 2) {
     const double a = 0.5 * (grad_v(0, 1) - grad_v(1, 0)) * dt;  // W_xy dt
     const double dxx = 2.0 * a * s[3], dxy = a * (s[1] - s[0]);

@@ -1,10 +1,13 @@
 // shape.hpp — shape functions on the structured grid (internal).
 //
 // Each shape function is a small struct with a compile-time stencil width K
-// (nodes per axis) and one `eval` that, for a particle coordinate expressed in
-// cell units along one axis, returns the first node of its stencil and the
-// K weights and derivatives (per cell unit). The tensor product over axes is
-// formed by `Stencil`. Everything is inline, branch-light and allocation-free:
+// (nodes per axis), a `locate` that, for a particle coordinate expressed in
+// cell units along one axis, returns the cell its stencil is anchored to,
+// and an `eval` that, given that cell, returns the first node of the stencil
+// and the K weights and derivatives (per cell unit). The tensor product over
+// axes is formed by `Stencil`. Locating (a truncation, a clamp, an integer
+// conversion per axis) is about a third of a stencil's cost; the time step
+// locates once per step and reuses the cells while particles do not move. Everything is inline, branch-light and allocation-free:
 // it runs several times per particle per step.
 //
 // Stencils never leave the grid: at the grid boundary the first node is
@@ -24,11 +27,12 @@ namespace hmpm::shape {
 /// Linear hat functions: 2 nodes per axis.
 struct Linear {
   static constexpr int K = 2;
-  static inline void eval(double xi, int cells, double /*half_length*/, int& base, double* w,
-                          double* dw) {
+  static inline int locate(double xi, int cells) {
     // Particles are inside the grid (xi >= 0), so truncation is floor.
-    int b = static_cast<int>(xi);
-    b = std::clamp(b, 0, cells - 1);
+    return std::clamp(static_cast<int>(xi), 0, cells - 1);
+  }
+  static inline void eval(double xi, int b, int /*cells*/, double /*half_length*/, int& base,
+                          double* w, double* dw) {
     const double f = xi - b;
     base = b;
     w[0] = 1.0 - f;
@@ -61,10 +65,11 @@ struct Gimp {
       ds = 0.0;
     }
   }
-  static inline void eval(double xi, int cells, double half_length, int& base, double* w,
-                          double* dw) {
-    int b = static_cast<int>(xi + 0.5) - 1;  // xi >= 0 inside the grid
-    b = std::clamp(b, 0, cells - 2);
+  static inline int locate(double xi, int cells) {
+    return std::clamp(static_cast<int>(xi + 0.5) - 1, 0, cells - 2);  // xi >= 0 inside the grid
+  }
+  static inline void eval(double xi, int b, int /*cells*/, double half_length, int& base,
+                          double* w, double* dw) {
     base = b;
     for (int k = 0; k < 3; ++k) weight(xi - (b + k), half_length, w[k], dw[k]);
   }
@@ -73,9 +78,11 @@ struct Gimp {
 /// Quadratic B-spline, 3 nodes per axis, clamped at the grid boundary.
 struct BSpline {
   static constexpr int K = 3;
-  static inline void eval(double xi, int cells, double /*half_length*/, int& base, double* w,
-                          double* dw) {
-    const int b = static_cast<int>(std::floor(xi - 0.5));
+  /// The cell of the middle node's left neighbour; -1 or cells - 1 next to
+  /// the boundary, where eval folds the ghost node in.
+  static inline int locate(double xi, int /*cells*/) { return static_cast<int>(std::floor(xi - 0.5)); }
+  static inline void eval(double xi, int b, int cells, double /*half_length*/, int& base,
+                          double* w, double* dw) {
     const double f = xi - b;  // in [0.5, 1.5)
     double w0 = 0.5 * (1.5 - f) * (1.5 - f), w1 = 0.75 - (f - 1.0) * (f - 1.0),
            w2 = 0.5 * (f - 0.5) * (f - 0.5);
@@ -122,10 +129,22 @@ struct Stencil {
   template <bool Grad = true, class Vec>
   inline void compute(const Vec& x, const double* origin, const double* inv_h, const int* cells,
                       const std::int64_t* stride, double half_length) {
+    std::int32_t cell[Dim];
+    compute<Grad, false>(x, origin, inv_h, cells, stride, half_length, cell);
+  }
+
+  /// As compute; Located = false also stores each axis's cell (Shape::locate)
+  /// in `cell`, Located = true takes them from there (the same x, so the
+  /// same cells: a particle located earlier in the step).
+  template <bool Grad, bool Located, class Vec>
+  inline void compute(const Vec& x, const double* origin, const double* inv_h, const int* cells,
+                      const std::int64_t* stride, double half_length, std::int32_t* cell) {
     int base[Dim];
     double wa[Dim][K], da[Dim][K];
     for (int a = 0; a < Dim; ++a) {
-      Shape::eval((x[a] - origin[a]) * inv_h[a], cells[a], half_length, base[a], wa[a], da[a]);
+      const double xi = (x[a] - origin[a]) * inv_h[a];
+      if constexpr (!Located) cell[a] = Shape::locate(xi, cells[a]);
+      Shape::eval(xi, cell[a], cells[a], half_length, base[a], wa[a], da[a]);
       if constexpr (Grad)
         for (int k = 0; k < K; ++k) da[a][k] *= inv_h[a];
     }

@@ -332,9 +332,9 @@ class Simulation {
     if (fluid_) {
       for_particles(kFlux, [&](const Scatter& out, std::size_t b, std::size_t e) {
         if (plastic_)
-          update_particle_stress_and_fluid_flux</*Move=*/false, /*Plastic=*/true>(out, b, e, dt);
+          update_particle_stress_and_fluid_flux</*Fluid=*/true, /*Plastic=*/true>(out, b, e, dt);
         else
-          update_particle_stress_and_fluid_flux</*Move=*/false, /*Plastic=*/false>(out, b, e, dt);
+          update_particle_stress_and_fluid_flux</*Fluid=*/true, /*Plastic=*/false>(out, b, e, dt);
       });
       update_nodal_pressure(t + dt, dt);
       for_particles(0u, [&](const Scatter&, std::size_t b, std::size_t e) {
@@ -343,9 +343,9 @@ class Simulation {
     } else {
       for_particles(0u, [&](const Scatter& out, std::size_t b, std::size_t e) {
         if (plastic_)
-          update_particle_stress_and_fluid_flux</*Move=*/true, /*Plastic=*/true>(out, b, e, dt);
+          update_particle_stress_and_fluid_flux</*Fluid=*/false, /*Plastic=*/true>(out, b, e, dt);
         else
-          update_particle_stress_and_fluid_flux</*Move=*/true, /*Plastic=*/false>(out, b, e, dt);
+          update_particle_stress_and_fluid_flux</*Fluid=*/false, /*Plastic=*/false>(out, b, e, dt);
       });
     }
   }
@@ -472,10 +472,21 @@ class Simulation {
     return std::clamp<std::size_t>(n / (16 * static_cast<std::size_t>(pool_->size())), 64, largest);
   }
 
+  /// The stencil of particle p at its current position.
   template <bool Grad = true>
   inline void stencil_of(std::size_t p, StencilT& s) const {
     s.template compute<Grad>(particles_.x[p], grid_.origin, grid_.inv_h, grid_.cells, grid_.stride,
               particles_.half_length.empty() ? 0.0 : particles_.half_length[p]);
+  }
+
+  /// In the step: the first phase locates each particle's stencil (and
+  /// records the cells), the later phases, before particles move, reuse them.
+  template <bool Grad, bool Located>
+  inline void stencil_in_step(std::size_t p, StencilT& s) {
+    s.template compute<Grad, Located>(particles_.x[p], grid_.origin, grid_.inv_h, grid_.cells,
+                                      grid_.stride,
+                                      particles_.half_length.empty() ? 0.0 : particles_.half_length[p],
+                                      particles_.cell[p].data());
   }
 
   void clear_grid() {
@@ -512,8 +523,13 @@ class Simulation {
   void map_particles_to_grid(const Scatter& out, std::size_t begin, std::size_t end) {
     StencilT s;
     NodeRange touched{grid_.count, -1};
+    // Local copies: Eigen's vector stores may alias anything for the
+    // compiler, which otherwise reloads these pointers at every node.
+    double* const mass_out = out.mass;
+    Vec* const momentum_out = out.momentum;
+    Vec* const force_out = out.force;
     for (std::size_t p = begin; p < end; ++p) {
-      stencil_of(p, s);
+      stencil_in_step<true, false>(p, s);
       touched.lo = std::min(touched.lo, s.node[0]);  // stencil nodes are in increasing order
       touched.hi = std::max(touched.hi, s.node[StencilT::N - 1]);
       const double m = particles_.mass[p];
@@ -523,9 +539,9 @@ class Simulation {
       for (int k = 0; k < StencilT::N; ++k) {
         const std::int64_t i = s.node[k];
         const double w = s.w[k];
-        out.mass[i] += w * m;
-        out.momentum[i] += w * mv;
-        out.force[i].noalias() -= vol_sig * s.grad(k);
+        mass_out[i] += w * m;
+        momentum_out[i] += w * mv;
+        force_out[i].noalias() -= vol_sig * s.grad(k);
       }
       if (fluid_) {
         const std::uint16_t mat = particles_.material[p];
@@ -561,7 +577,7 @@ class Simulation {
     StencilT s;
     for (std::size_t p = begin; p < end; ++p) {
       if (!constants_[particles_.material[p]].saturated) continue;
-      stencil_of(p, s);
+      stencil_in_step<true, true>(p, s);
       double p_hat = 0.0;
       for (int k = 0; k < StencilT::N; ++k) p_hat += s.w[k] * grid_.pressure[s.node[k]];
       const double vp = particles_.volume[p] * p_hat;
@@ -662,7 +678,7 @@ class Simulation {
                                             double dt) {
     StencilT s;
     for (std::size_t p = begin; p < end; ++p) {
-      stencil_of<false>(p, s);
+      stencil_in_step<false, true>(p, s);
       Vec a = Vec::Zero();
       for (int k = 0; k < StencilT::N; ++k) a += s.w[k] * grid_.accel[s.node[k]];
       particles_.v[p] += dt * a;
@@ -766,22 +782,23 @@ class Simulation {
 
   /// Phase 4: strain increment from the re-mapped nodal velocities, stress
   /// update, volume and porosity; the fluid flux of the mass balance,
-  /// -N V div v + V grad N . w, is scattered to the nodes. When Move, the
-  /// particles also move with the Lagrangian nodal velocity (dry runs; in
-  /// saturated runs the last phase moves them).
-  template <bool Move, bool Plastic>
+  /// -N V div v + V grad N . w, is scattered to the nodes (Fluid: runs with
+  /// a saturated material). In dry runs (!Fluid) the particles also move
+  /// with the Lagrangian nodal velocity; in saturated runs the last phase
+  /// moves them.
+  template <bool Fluid, bool Plastic>
   void update_particle_stress_and_fluid_flux(const Scatter& out, std::size_t begin, std::size_t end,
                                              double dt) {
     StencilT s;
     for (std::size_t p = begin; p < end; ++p) {
-      stencil_of(p, s);
+      stencil_in_step<true, true>(p, s);
       Mat grad_v = Mat::Zero();
       for (int k = 0; k < StencilT::N; ++k)
         grad_v.noalias() += grid_.remap[s.node[k]] * s.grad(k).transpose();
       const double vol = particles_.volume[p];
       const std::uint16_t mat = particles_.material[p];
       const MaterialConstants& mc = constants_[mat];
-      if (fluid_ && mc.saturated) {
+      if (Fluid && mc.saturated) {
         const double div_v = grad_v.trace();
         Vec grad_p = Vec::Zero(), a = Vec::Zero();
         for (int k = 0; k < StencilT::N; ++k) {
@@ -814,11 +831,12 @@ class Simulation {
       for (int c = 3; c < kEnd; ++c) sig[c] += two_g * de[c];
       if constexpr (Plastic) return_to_yield_surface(sig, mc);
       for (int c = 0; c < kEnd; ++c) particles_.strain[p][c] += de[c];
-      const double j = (Mat::Identity() + dt * grad_v).determinant();
+      const Mat f = Mat::Identity() + dt * grad_v;  // a plain matrix: its determinant inlines
+      const double j = f.determinant();
       if (!(j > 0.0)) fail_volume(p, j);
       particles_.volume[p] = vol * j;
-      if (fluid_ && mc.saturated) particles_.porosity[p] = 1.0 - (1.0 - particles_.porosity[p]) / j;
-      if constexpr (Move) move_particle(p, s, dt);
+      if (Fluid && mc.saturated) particles_.porosity[p] = 1.0 - (1.0 - particles_.porosity[p]) / j;
+      if constexpr (!Fluid) move_particle(p, s, dt);
     }
   }
 
@@ -840,7 +858,7 @@ class Simulation {
   void update_particle_pressure_and_position(std::size_t begin, std::size_t end, double dt) {
     StencilT s;
     for (std::size_t p = begin; p < end; ++p) {
-      stencil_of<false>(p, s);
+      stencil_in_step<false, true>(p, s);
       if (constants_[particles_.material[p]].saturated) {
         double dp = 0.0, p_new = 0.0;  // weights only: this pass needs no gradient
         for (int k = 0; k < StencilT::N; ++k) {

@@ -7,6 +7,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <array>
 #include <cstdint>
 #include <vector>
 
@@ -29,6 +30,10 @@ struct ParticleState {
   std::vector<Voigt> stress;  ///< effective stress sigma', Pa, compression negative
   std::vector<Voigt> strain;  ///< small-strain accumulation, tensor components
   std::vector<std::uint16_t> material;
+  /// Per axis, the cell the particle's stencil is anchored to (Shape::locate),
+  /// set by the step's first phase and reused by the later ones of the same
+  /// step (particles move in the last).
+  std::vector<std::array<std::int32_t, Dim>> cell;
   std::vector<double> half_length;  ///< GIMP particle half-length in cell units; empty otherwise
 
   // Fluid phase (empty when dry).
@@ -44,6 +49,7 @@ struct ParticleState {
     mass.resize(n); volume.resize(n);
     stress.assign(n, Voigt::Zero()); strain.assign(n, Voigt::Zero());
     material.resize(n);
+    cell.resize(n);
     if (gimp) half_length.resize(n);
     if (fluid) {
       pressure.assign(n, 0.0); pressure_out.assign(n, 0.0);
@@ -53,7 +59,8 @@ struct ParticleState {
 
   std::int64_t bytes() const {
     const std::size_t n = size();
-    std::size_t per = sizeof(Vec) * 3 + sizeof(double) * 2 + sizeof(Voigt) * 2 + sizeof(std::uint16_t);
+    std::size_t per = sizeof(Vec) * 3 + sizeof(double) * 2 + sizeof(Voigt) * 2 + sizeof(std::uint16_t) +
+                      sizeof(std::array<std::int32_t, Dim>);
     if (!half_length.empty()) per += sizeof(double);
     if (!pressure.empty()) per += sizeof(double) * 3 + sizeof(Vec);
     return static_cast<std::int64_t>(n * per);
