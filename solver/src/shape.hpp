@@ -7,8 +7,9 @@
 // and the K weights and derivatives (per cell unit). The tensor product over
 // axes is formed by `Stencil`. Locating (a truncation, a clamp, an integer
 // conversion per axis) is about a third of a stencil's cost; the time step
-// locates once per step and reuses the cells while particles do not move. Everything is inline, branch-light and allocation-free:
-// it runs several times per particle per step.
+// locates once per step and reuses the cells while particles do not move.
+// Everything is inline, branch-light and allocation-free: it runs several
+// times per particle per step.
 //
 // Stencils never leave the grid: at the grid boundary the first node is
 // clamped, and for the quadratic B-spline the weight of the missing ghost node
