@@ -54,9 +54,6 @@ std::vector<double> final_state(const hmpm::Problem& p, int threads) {
   return out;
 }
 
-// Tolerance: sums of up to 9 nodal contributions reordered per step give
-// relative differences of ~1e-16 per step; over 600 steps of a stable,
-// non-chaotic elastic response they stay below 1e-9 of each field's scale.
 // The dry block: its stress pass (which also moves the particles) shares
 // particles between the threads in dynamic blocks, not fixed chunks.
 hmpm::Problem dry_block() {
@@ -67,6 +64,9 @@ hmpm::Problem dry_block() {
   return p;
 }
 
+// Tolerance: sums of up to 9 nodal contributions reordered per step give
+// relative differences of ~1e-16 per step; over 600 steps of a stable,
+// non-chaotic elastic response they stay below 1e-9 of each field's scale.
 TEST(Threads, TwoThreadsAgreeWithOneAndAreDeterministic) {
   for (bool dry : {false, true})
   for (auto shape : {hmpm::ShapeFunction::linear, hmpm::ShapeFunction::gimp}) {
