@@ -10,6 +10,7 @@
 #include <chrono>
 #include <regex>
 #include <set>
+#include <sstream>
 #include <thread>
 
 #include "digest.hpp"
@@ -239,6 +240,40 @@ TEST_F(RoutesTest, HostileBodiesGetProblemDocumentsAndTheServerKeepsAnswering) {
   EXPECT_TRUE(json_of(client_->Get("/jobs")->body)["jobs"].empty());  // nothing was stored
 }
 
+// Allow on a 405 names exactly the methods the path serves: each one listed
+// answers something other than 405, and the expected sets are complete.
+// (Before the route table, every path but /jobs claimed "GET, DELETE".)
+TEST_F(RoutesTest, AllowListsExactlyTheMethodsServed) {
+  start();
+  const std::string job = "/jobs/00000000-0000-4000-8000-000000000000";
+  const std::vector<std::pair<std::string, std::string>> expected{
+      {"/health", "GET, HEAD"},
+      {"/metrics", "GET, HEAD"},
+      {"/jobs", "GET, HEAD, POST"},
+      {job, "GET, HEAD, DELETE"},
+      {job + "/spec", "GET, HEAD"},
+      {job + "/results", "GET, HEAD"},
+      {job + "/results/summary.json", "GET, HEAD"},
+      {job + "/events", "GET, HEAD"},
+  };
+  for (const auto& [path, allow] : expected) {
+    auto res = client_->Patch(path.c_str(), "{}", "application/json");
+    expect_problem(res, 405, "method-not-allowed");
+    EXPECT_EQ(res->get_header_value("Allow"), allow) << path;
+    std::stringstream methods(allow);
+    for (std::string method; std::getline(methods >> std::ws, method, ',');) {
+      const std::string body = method == "POST" ? "{}" : "";
+      const std::string answer =
+          raw_http(port_,
+                   method + " " + path + " HTTP/1.1\r\nHost: x\r\nConnection: close\r\n" +
+                       "Content-Length: " + std::to_string(body.size()) + "\r\n\r\n" + body,
+                   5.0);
+      EXPECT_NE(raw_status(answer), 405) << method << " " << path << " is listed in Allow";
+      EXPECT_NE(raw_status(answer), 0) << method << " " << path;
+    }
+  }
+}
+
 TEST_F(RoutesTest, BodiesWithoutLengthOrOverTheLimitAreRefused) {
   ServiceConfig c = config();
   c.max_body_bytes = 64 * 1024;
@@ -464,8 +499,8 @@ TEST_F(RoutesTest, StopRequeuesTheRunningJobAndTheNextStartFinishesIt) {
   stop();
   EXPECT_LT(std::chrono::duration<double>(Clock::now() - t0).count(), 5.0);
   {
-    JobStore store(config().db_path);
-    const auto job = store.find(id);
+    const auto store = open_sqlite_store(config().db_path);
+    const auto job = store->find(id);
     ASSERT_TRUE(job);
     EXPECT_EQ(job->status, JobStatus::accepted);
     EXPECT_EQ(job->attempts, 0);  // a graceful stop is not the job's fault
