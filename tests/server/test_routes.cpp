@@ -84,6 +84,13 @@ class RoutesTest : public ::testing::Test {
         *client_, id, [&](const Json& d) { return d.value("status", "") == status; }, timeout_s);
   }
 
+  // Submits a job that runs for hours and waits until a worker runs it.
+  std::string submit_running(const std::string& name) {
+    const std::string id = submit(long_spec(name, 10000));
+    EXPECT_EQ(wait_until(id, "running", 30).value("status", ""), "running");
+    return id;
+  }
+
   Json wait_final(const std::string& id, double timeout_s = 60) {
     return poll_job(*client_, id, is_final, timeout_s);
   }
@@ -387,8 +394,7 @@ TEST_F(RoutesTest, FullQueueAnswers503WithRetryAfter) {
   ServiceConfig c = config();
   c.max_queue = 1;
   start(c);
-  const std::string long_id = submit(long_spec("long", 10000));
-  ASSERT_EQ(wait_until(long_id, "running", 30).value("status", ""), "running");
+  const std::string long_id = submit_running("long");
   submit(small_spec("waits"));
   auto res = client_->Post("/jobs", small_spec("refused"), "application/json");
   expect_problem(res, 503, "queue-full");
@@ -509,6 +515,34 @@ TEST_F(RoutesTest, StopRequeuesTheRunningJobAndTheNextStartFinishesIt) {
   const Json done = wait_final(id, 90);
   EXPECT_EQ(done.value("status", ""), "successful") << done.dump();
   EXPECT_EQ(done.value("attempts", 0), 1);
+}
+
+// The heartbeat renews the lease of a running job: with a 0.3 s lease, the
+// job is still held long after the lease would have lapsed unrenewed.
+TEST_F(RoutesTest, TheHeartbeatKeepsARunningJobsLeaseLive) {
+  ServiceConfig c = config();
+  c.lease_s = 0.3;
+  start(c);
+  const std::string id = submit_running("leased");
+  std::this_thread::sleep_for(std::chrono::milliseconds(1200));
+  sqlite3* db = nullptr;
+  ASSERT_EQ(sqlite3_open((dir_ / "db" / "hmpm.sqlite").c_str(), &db), SQLITE_OK);
+  sqlite3_stmt* stmt = nullptr;
+  ASSERT_EQ(sqlite3_prepare_v2(db,
+                               "SELECT lease_expires_ms - CAST((julianday('now') - 2440587.5) * "
+                               "86400000 AS INTEGER), owner FROM jobs WHERE id = ?1",
+                               -1, &stmt, nullptr),
+            SQLITE_OK);
+  sqlite3_bind_text(stmt, 1, id.c_str(), -1, SQLITE_TRANSIENT);
+  ASSERT_EQ(sqlite3_step(stmt), SQLITE_ROW);
+  const auto remaining_ms = sqlite3_column_int64(stmt, 0);
+  const std::string owner = reinterpret_cast<const char*>(sqlite3_column_text(stmt, 1));
+  sqlite3_finalize(stmt);
+  sqlite3_close(db);
+  EXPECT_GT(remaining_ms, 0) << "the lease lapsed while the job ran";
+  EXPECT_LE(remaining_ms, 300);
+  EXPECT_FALSE(owner.empty());
+  EXPECT_EQ(client_->Delete(("/jobs/" + id).c_str())->status, 200);
 }
 
 TEST_F(RoutesTest, WallTimeLimitFailsTheJobWithAReason) {
