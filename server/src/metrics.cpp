@@ -23,11 +23,10 @@ void Metrics::observe_job(double seconds, JobStatus outcome) {
 std::string Metrics::render(const StatusCounts& counts, int workers) const {
   std::ostringstream out;
   out << "# HELP hmpm_jobs Jobs in the store by status.\n# TYPE hmpm_jobs gauge\n";
-  for (JobStatus s : {JobStatus::accepted, JobStatus::running, JobStatus::successful,
-                      JobStatus::failed, JobStatus::dismissed}) {
-    const auto it = counts.find(s);
-    out << "hmpm_jobs{status=\"" << status_name(s) << "\"} "
-        << (it == counts.end() ? 0 : it->second) << "\n";
+  for (const auto& row : job_statuses) {
+    const auto it = counts.find(row.status);
+    out << "hmpm_jobs{status=\"" << row.name << "\"} " << (it == counts.end() ? 0 : it->second)
+        << "\n";
   }
   const auto queued = counts.find(JobStatus::accepted);
   out << "# HELP hmpm_queue_length Jobs waiting for a worker.\n# TYPE hmpm_queue_length gauge\n"

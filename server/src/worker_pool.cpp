@@ -49,6 +49,24 @@ std::filesystem::path WorkerPool::job_dir(const std::string& id) const {
 void WorkerPool::start() {
   std::lock_guard<std::mutex> lock(mutex_);
   for (int i = 0; i < settings_.workers; ++i) threads_.emplace_back([this] { work(); });
+  heartbeat_ = std::thread([this] { heartbeat(); });
+}
+
+void WorkerPool::heartbeat() {
+  std::unique_lock<std::mutex> lock(mutex_);
+  while (!stopping_) {
+    heartbeat_wake_.wait_for(lock, std::chrono::duration<double>(settings_.lease_renewal_s),
+                             [&] { return stopping_; });
+    if (stopping_) return;
+    if (running_.empty()) continue;
+    lock.unlock();
+    try {
+      store_.renew_leases(settings_.claimant);
+    } catch (const std::exception& e) {
+      log_line({{"event", "store_error"}, {"detail", e.what()}, {"during", "lease renewal"}});
+    }
+    lock.lock();
+  }
 }
 
 void WorkerPool::notify() {
@@ -75,8 +93,10 @@ void WorkerPool::shutdown() {
     stopping_ = true;
     for (auto& [id, running] : running_) running->cancel = true;
     threads.swap(threads_);
+    if (heartbeat_.joinable()) threads.push_back(std::move(heartbeat_));
   }
   wake_.notify_all();
+  heartbeat_wake_.notify_all();
   for (auto& t : threads) t.join();
 }
 
@@ -90,7 +110,7 @@ void WorkerPool::work() {
     }
     std::optional<JobRecord> job;
     try {
-      job = store_.claim_next();
+      job = store_.claim_next(settings_.claimant);
     } catch (const std::exception& e) {
       log_line({{"event", "store_error"}, {"detail", e.what()}});
     }
@@ -111,7 +131,7 @@ void WorkerPool::work() {
     }
     if (!registered) {  // shutdown began between claim and here
       try {
-        store_.requeue(job->id);
+        store_.requeue(claim_of(*job));
       } catch (const std::exception& e) {  // recovery at the next start requeues it
         log_line({{"event", "store_error"}, {"job", job->id}, {"detail", e.what()}});
       }
@@ -133,6 +153,7 @@ void WorkerPool::work() {
 
 void WorkerPool::run_one(const JobRecord& job, Running& running) {
   const auto t0 = SteadyClock::now();
+  const Claim claim = claim_of(job);
   log_transition(job.id, JobStatus::running, {{"attempt", job.attempts}});
   const std::filesystem::path dir = job_dir(job.id);
   std::error_code ec;
@@ -157,8 +178,11 @@ void WorkerPool::run_one(const JobRecord& job, Running& running) {
         return;
       last_write = now;
       try {
-        if (!store_.update_progress(job.id, std::clamp(100.0 * p.fraction, 0.0, 100.0))) {
-          running.dismissed = true;  // dismissed through another path: stop
+        const ClaimState state =
+            store_.update_progress(claim, std::clamp(100.0 * p.fraction, 0.0, 100.0));
+        if (state != ClaimState::held) {  // dismissed through another path, or taken over: stop
+          running.dismissed = state == ClaimState::dismissed;
+          running.lost = state == ClaimState::lost;
           running.cancel = true;
         }
       } catch (const std::exception& e) {
@@ -181,6 +205,10 @@ void WorkerPool::run_one(const JobRecord& job, Running& running) {
   }
   const double seconds = seconds_since(t0);
 
+  if (running.lost) {  // another instance owns the job and its folder now
+    log_line({{"event", "job"}, {"job", job.id}, {"claim", "lost"}, {"seconds", seconds}});
+    return;
+  }
   if (running.dismissed) {
     std::filesystem::remove_all(dir, ec);
     metrics_.observe_job(seconds, JobStatus::dismissed);
@@ -189,7 +217,7 @@ void WorkerPool::run_one(const JobRecord& job, Running& running) {
   }
   if (running.cancel && outcome != JobStatus::successful) {  // shutdown: run it again next start
     std::filesystem::remove_all(dir, ec);
-    store_.requeue(job.id);
+    store_.requeue(claim);
     log_transition(job.id, JobStatus::accepted, {{"requeued", true}, {"seconds", seconds}});
     return;
   }
@@ -207,7 +235,12 @@ void WorkerPool::run_one(const JobRecord& job, Running& running) {
     files.push_back({name, static_cast<std::int64_t>(size), *sha, hmpm::api::media_type_for(name)});
   }
   const std::string message = outcome == JobStatus::successful ? "finished" : reason;
-  if (!store_.finish(job.id, outcome, message, reason, files, seconds)) {
+  const ClaimState state = store_.finish(claim, JobEnd{outcome, message, reason, files, seconds});
+  if (state == ClaimState::lost) {  // taken over while finishing: the files are not ours
+    log_line({{"event", "job"}, {"job", job.id}, {"claim", "lost"}, {"seconds", seconds}});
+    return;
+  }
+  if (state == ClaimState::dismissed) {
     std::filesystem::remove_all(dir, ec);  // dismissed while finishing
     log_transition(job.id, JobStatus::dismissed, {{"seconds", seconds}});
     return;

@@ -9,6 +9,11 @@
 // Cancellation is cooperative: each running job has an atomic flag the solver
 // checks once per step. A client's DELETE dismisses the job; a shutdown puts
 // it back in the queue so the next start resumes it.
+//
+// Every job is claimed for this process's instance (`WorkerSettings::claimant`);
+// a heartbeat thread renews the leases of the running jobs every
+// `lease_renewal_s`, and a worker whose claim was lost stops without touching
+// the job's files (another instance owns them now).
 #pragma once
 
 #include <atomic>
@@ -35,6 +40,8 @@ struct WorkerSettings {
   double progress_interval_s = 1.0;  ///< how often progress reaches the store
   std::filesystem::path data_dir;
   hmpm::api::Limits limits;
+  Claimant claimant;              ///< this process's instance id and lease length
+  double lease_renewal_s = 10.0;  ///< heartbeat period; well under claimant.lease_s
 };
 
 class WorkerPool {
@@ -61,19 +68,23 @@ class WorkerPool {
   struct Running {
     std::atomic<bool> cancel{false};
     std::atomic<bool> dismissed{false};
+    std::atomic<bool> lost{false};  ///< another claim replaced ours
   };
   void work();
+  void heartbeat();
   void run_one(const JobRecord& job, Running& running);
 
   JobStore& store_;
   Metrics& metrics_;
   WorkerSettings settings_;
   std::mutex mutex_;
-  std::condition_variable wake_;
+  std::condition_variable wake_;            ///< workers: a job was queued, or stop
+  std::condition_variable heartbeat_wake_;  ///< the heartbeat thread: stop
   bool stopping_ = false;
   std::uint64_t generation_ = 0;  ///< bumped by notify()
   std::map<std::string, std::shared_ptr<Running>> running_;
   std::vector<std::thread> threads_;
+  std::thread heartbeat_;
 };
 
 }  // namespace hmpm::server

@@ -79,11 +79,12 @@ class ServerProcess {
   ServerProcess& operator=(const ServerProcess&) = delete;
 
   int port() const { return port_; }
+  pid_t pid() const { return pid_; }
   std::string first_line() const { return first_line_; }
   std::string log() const { return read_file(log_path_); }
 
-  /// Sends `signal` and waits up to `timeout_s`; returns the exit status
-  /// (-1 if it did not exit, 128 + n when killed by signal n).
+  /// Sends `signal` (0: none) and waits up to `timeout_s`; returns the exit
+  /// status (-1 if it did not exit, 128 + n when killed by signal n).
   int signal_and_wait(int signal, double timeout_s) {
     ::kill(pid_, signal);
     const auto deadline = Clock::now() + std::chrono::duration<double>(timeout_s);
@@ -330,6 +331,75 @@ TEST_F(ServiceTest, KillNineThenRestartEndsEveryJob) {
   EXPECT_EQ(status_of(resumed), "successful") << resumed.dump();
   EXPECT_EQ(resumed.value("attempts", 0), 2);  // killed once, resumed once
   EXPECT_NE(server_->log().find("\"recovered\":true"), std::string::npos);
+}
+
+// Issue 22 item 1: a second server on the same database used to requeue the
+// first one's running job, rerun it in the same folder and delete it. Now it
+// refuses to start, naming the first one's pid, before it recovers anything.
+TEST_F(ServiceTest, ASecondServerOnTheSameDatabaseRefusesAndTheRunningJobIsUntouched) {
+  start({"--workers", "1"});
+  auto client = server_->client();
+  const std::string id = submit(client, long_spec("owned-by-the-first", 30));
+  ASSERT_EQ(status_of(poll_job(
+                client, id, [](const Json& d) { return d.value("status", "") == "running"; }, 30)),
+            "running");
+
+  const auto other = dir_ / "second";
+  std::filesystem::create_directories(other);
+  ServerProcess second(
+      other, {"--db", (dir_ / "hmpm.sqlite").string(), "--data-dir", (other / "results").string()});
+  EXPECT_EQ(second.port(), -1) << "the second server started: " << second.first_line();
+  EXPECT_EQ(second.signal_and_wait(0, 10), 1);
+  const std::string refusal = second.log();
+  EXPECT_NE(refusal.find("in use by another hmpm-server (pid " + std::to_string(server_->pid())),
+            std::string::npos)
+      << refusal;
+
+  const Json running = poll_job(
+      client, id, [](const Json&) { return true; }, 5);
+  EXPECT_EQ(status_of(running), "running") << running.dump();
+  EXPECT_EQ(running.value("attempts", 0), 1);
+  const Json done = poll_job(client, id, is_final, 120);
+  EXPECT_EQ(status_of(done), "successful") << done.dump();
+  EXPECT_EQ(done.value("attempts", 0), 1);  // never rerun
+  auto manifest = client.Get(("/jobs/" + id + "/results").c_str());
+  ASSERT_TRUE(manifest);
+  ASSERT_EQ(manifest->status, 200);
+  const Json files = json_of(manifest->body)["files"];
+  ASSERT_FALSE(files.empty());
+  for (const Json& f : files) {
+    auto file = client.Get(f["href"].get<std::string>().c_str());
+    ASSERT_TRUE(file);
+    EXPECT_EQ(file->status, 200) << f.dump();  // never deleted
+    EXPECT_EQ(file->body.size(), f["size"].get<std::size_t>());
+  }
+  EXPECT_EQ(server_->log().find("\"recovered\":true"), std::string::npos);
+}
+
+TEST_F(ServiceTest, ASecondServerOnTheSameDataFolderRefuses) {
+  start();
+  const auto other = dir_ / "second";
+  std::filesystem::create_directories(other);
+  ServerProcess second(other, {"--data-dir", (dir_ / "results").string()});
+  EXPECT_EQ(second.port(), -1) << "the second server started: " << second.first_line();
+  EXPECT_EQ(second.signal_and_wait(0, 10), 1);
+  EXPECT_NE(second.log().find("data folder"), std::string::npos) << second.log();
+  EXPECT_NE(second.log().find("(pid " + std::to_string(server_->pid())), std::string::npos)
+      << second.log();
+  EXPECT_EQ(server_->client().Get("/health")->status, 200);
+}
+
+// cpp-httplib's default socket options set SO_REUSEPORT, so a second server
+// on the same port bound it too and the kernel split the connections.
+TEST_F(ServiceTest, ASecondServerOnTheSamePortFailsToBind) {
+  start();
+  const auto other = dir_ / "second";
+  std::filesystem::create_directories(other);
+  ServerProcess second(other, {"--port", std::to_string(server_->port())});
+  EXPECT_EQ(second.port(), -1) << "the second server bound the port: " << second.first_line();
+  EXPECT_EQ(second.signal_and_wait(0, 10), 1);
+  EXPECT_NE(second.log().find("cannot listen"), std::string::npos) << second.log();
+  EXPECT_EQ(server_->client().Get("/health")->status, 200);
 }
 
 TEST_F(ServiceTest, EightClientsSubmitNinetySixJobsWhilePolling) {

@@ -14,6 +14,8 @@
 #include <sstream>
 #include <thread>
 
+#include "hmpm/server/job_status.hpp"
+
 namespace hmpm::server::testing {
 
 std::string small_spec(const std::string& name, double end_s) {
@@ -105,9 +107,9 @@ std::string raw_body(const std::string& response) {
 }
 
 bool is_final(const Json& doc) {
-  if (!doc.is_object() || !doc.contains("status")) return false;
-  const auto s = doc["status"].get<std::string>();
-  return s == "successful" || s == "failed" || s == "dismissed";
+  if (!doc.is_object() || !doc.contains("status") || !doc["status"].is_string()) return false;
+  const auto status = parse_status(doc["status"].get<std::string>());
+  return status && is_terminal(*status);
 }
 
 Json json_of(const std::string& body) {

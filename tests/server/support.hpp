@@ -41,7 +41,7 @@ Json poll_job(httplib::Client& client, const std::string& id,
               const std::function<bool(const Json&)>& done, double timeout_s,
               const httplib::Headers& headers = {});
 
-/// True for successful, failed and dismissed.
+/// True when the document's status is a terminal one of the job-status table.
 bool is_final(const Json& doc);
 
 /// The body parsed as JSON, or null when it is not JSON.

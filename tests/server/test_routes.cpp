@@ -10,6 +10,7 @@
 #include <chrono>
 #include <regex>
 #include <set>
+#include <sstream>
 #include <thread>
 
 #include "digest.hpp"
@@ -81,6 +82,13 @@ class RoutesTest : public ::testing::Test {
   Json wait_until(const std::string& id, const std::string& status, double timeout_s = 60) {
     return poll_job(
         *client_, id, [&](const Json& d) { return d.value("status", "") == status; }, timeout_s);
+  }
+
+  // Submits a job that runs for hours and waits until a worker runs it.
+  std::string submit_running(const std::string& name) {
+    const std::string id = submit(long_spec(name, 10000));
+    EXPECT_EQ(wait_until(id, "running", 30).value("status", ""), "running");
+    return id;
   }
 
   Json wait_final(const std::string& id, double timeout_s = 60) {
@@ -239,6 +247,40 @@ TEST_F(RoutesTest, HostileBodiesGetProblemDocumentsAndTheServerKeepsAnswering) {
   EXPECT_TRUE(json_of(client_->Get("/jobs")->body)["jobs"].empty());  // nothing was stored
 }
 
+// Allow on a 405 names exactly the methods the path serves: each one listed
+// answers something other than 405, and the expected sets are complete.
+// (Before the route table, every path but /jobs claimed "GET, DELETE".)
+TEST_F(RoutesTest, AllowListsExactlyTheMethodsServed) {
+  start();
+  const std::string job = "/jobs/00000000-0000-4000-8000-000000000000";
+  const std::vector<std::pair<std::string, std::string>> expected{
+      {"/health", "GET, HEAD"},
+      {"/metrics", "GET, HEAD"},
+      {"/jobs", "GET, HEAD, POST"},
+      {job, "GET, HEAD, DELETE"},
+      {job + "/spec", "GET, HEAD"},
+      {job + "/results", "GET, HEAD"},
+      {job + "/results/summary.json", "GET, HEAD"},
+      {job + "/events", "GET, HEAD"},
+  };
+  for (const auto& [path, allow] : expected) {
+    auto res = client_->Patch(path.c_str(), "{}", "application/json");
+    expect_problem(res, 405, "method-not-allowed");
+    EXPECT_EQ(res->get_header_value("Allow"), allow) << path;
+    std::stringstream methods(allow);
+    for (std::string method; std::getline(methods >> std::ws, method, ',');) {
+      const std::string body = method == "POST" ? "{}" : "";
+      const std::string answer =
+          raw_http(port_,
+                   method + " " + path + " HTTP/1.1\r\nHost: x\r\nConnection: close\r\n" +
+                       "Content-Length: " + std::to_string(body.size()) + "\r\n\r\n" + body,
+                   5.0);
+      EXPECT_NE(raw_status(answer), 405) << method << " " << path << " is listed in Allow";
+      EXPECT_NE(raw_status(answer), 0) << method << " " << path;
+    }
+  }
+}
+
 TEST_F(RoutesTest, BodiesWithoutLengthOrOverTheLimitAreRefused) {
   ServiceConfig c = config();
   c.max_body_bytes = 64 * 1024;
@@ -352,8 +394,7 @@ TEST_F(RoutesTest, FullQueueAnswers503WithRetryAfter) {
   ServiceConfig c = config();
   c.max_queue = 1;
   start(c);
-  const std::string long_id = submit(long_spec("long", 10000));
-  ASSERT_EQ(wait_until(long_id, "running", 30).value("status", ""), "running");
+  const std::string long_id = submit_running("long");
   submit(small_spec("waits"));
   auto res = client_->Post("/jobs", small_spec("refused"), "application/json");
   expect_problem(res, 503, "queue-full");
@@ -464,8 +505,8 @@ TEST_F(RoutesTest, StopRequeuesTheRunningJobAndTheNextStartFinishesIt) {
   stop();
   EXPECT_LT(std::chrono::duration<double>(Clock::now() - t0).count(), 5.0);
   {
-    JobStore store(config().db_path);
-    const auto job = store.find(id);
+    const auto store = open_sqlite_store(config().db_path);
+    const auto job = store->find(id);
     ASSERT_TRUE(job);
     EXPECT_EQ(job->status, JobStatus::accepted);
     EXPECT_EQ(job->attempts, 0);  // a graceful stop is not the job's fault
@@ -474,6 +515,34 @@ TEST_F(RoutesTest, StopRequeuesTheRunningJobAndTheNextStartFinishesIt) {
   const Json done = wait_final(id, 90);
   EXPECT_EQ(done.value("status", ""), "successful") << done.dump();
   EXPECT_EQ(done.value("attempts", 0), 1);
+}
+
+// The heartbeat renews the lease of a running job: with a 0.3 s lease, the
+// job is still held long after the lease would have lapsed unrenewed.
+TEST_F(RoutesTest, TheHeartbeatKeepsARunningJobsLeaseLive) {
+  ServiceConfig c = config();
+  c.lease_s = 0.3;
+  start(c);
+  const std::string id = submit_running("leased");
+  std::this_thread::sleep_for(std::chrono::milliseconds(1200));
+  sqlite3* db = nullptr;
+  ASSERT_EQ(sqlite3_open((dir_ / "db" / "hmpm.sqlite").c_str(), &db), SQLITE_OK);
+  sqlite3_stmt* stmt = nullptr;
+  ASSERT_EQ(sqlite3_prepare_v2(db,
+                               "SELECT lease_expires_ms - CAST((julianday('now') - 2440587.5) * "
+                               "86400000 AS INTEGER), owner FROM jobs WHERE id = ?1",
+                               -1, &stmt, nullptr),
+            SQLITE_OK);
+  sqlite3_bind_text(stmt, 1, id.c_str(), -1, SQLITE_TRANSIENT);
+  ASSERT_EQ(sqlite3_step(stmt), SQLITE_ROW);
+  const auto remaining_ms = sqlite3_column_int64(stmt, 0);
+  const std::string owner = reinterpret_cast<const char*>(sqlite3_column_text(stmt, 1));
+  sqlite3_finalize(stmt);
+  sqlite3_close(db);
+  EXPECT_GT(remaining_ms, 0) << "the lease lapsed while the job ran";
+  EXPECT_LE(remaining_ms, 300);
+  EXPECT_FALSE(owner.empty());
+  EXPECT_EQ(client_->Delete(("/jobs/" + id).c_str())->status, 200);
 }
 
 TEST_F(RoutesTest, WallTimeLimitFailsTheJobWithAReason) {

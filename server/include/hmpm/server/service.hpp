@@ -1,10 +1,11 @@
 // service.hpp — hmpm-server as a library: the durable job queue behind HTTP.
 //
-// A Service owns the SQLite job store, the worker threads that run jobs and
-// the HTTP front end (cpp-httplib). The `hmpm-server` executable and the
-// tests drive it the same way: construct it from a ServiceConfig (this opens
-// and migrates the database and recovers jobs an earlier process left
-// running), `bind()`, then `run()` on a thread of your own until `stop()` is
+// A Service owns the job store, the worker threads that run jobs and the
+// HTTP front end (cpp-httplib). The `hmpm-server` executable and the tests
+// drive it the same way: construct it from a ServiceConfig (this locks the
+// data folder and the database, so a second server on either refuses to
+// start; opens and migrates the database and recovers jobs whose lease has
+// lapsed), `bind()`, then `run()` on a thread of your own until `stop()` is
 // called from elsewhere (a signal handler thread, a test's TearDown).
 //
 // Routes, status codes and problem types are documented in docs/api.md.
@@ -33,12 +34,15 @@ struct ServiceConfig {
   int http_threads = 24;               ///< connections served at once
   double progress_interval_s = 1.0;    ///< how often a running job's progress is stored
   double heartbeat_interval_s = 10.0;  ///< SSE comment line when nothing else was sent
+  double lease_s = 30.0;  ///< a running job's claim lapses this long after its last renewal
 };
 
 class Service {
  public:
-  /// Opens the database (throws hmpm::server::StoreFailure if it cannot),
-  /// creates the data folder and recovers interrupted jobs.
+  /// Creates and locks the data folder, opens and locks the database and
+  /// recovers interrupted jobs. Throws hmpm::server::StoreFailure if the
+  /// database cannot be opened, or another process holds it or the data
+  /// folder (the message names its pid).
   explicit Service(ServiceConfig config);
   ~Service();
   Service(const Service&) = delete;

@@ -1,43 +1,40 @@
-// store.hpp — the durable job queue: every job and its result files in SQLite.
+// store.hpp — the durable job queue behind an interface, and its records.
 //
-// The database is the single source of truth for the service: the HTTP
+// The store is the single source of truth for the service: the HTTP
 // handlers, the workers and a restarted server all read the same rows, so a
-// `201 Created` means the job is on disk (WAL, synchronous=FULL) before the
-// client hears about it. Writes run in `BEGIN IMMEDIATE` transactions with a
-// busy timeout, so concurrent writers queue instead of failing with
-// SQLITE_BUSY. Connections are never shared between threads: each operation
-// leases one from a small pool for the calling thread and returns it after.
-// The schema is versioned with `PRAGMA user_version` and migrated on open.
+// `201 Created` means the job is durable before the client hears about it.
 //
-// Domain outcomes (unknown job, queue full, idempotency conflict) are values;
-// only a failing database (disk full, corrupt file, newer schema) throws
-// StoreFailure, which the HTTP edge turns into a 500.
+// A running job is *claimed* by one server instance (`Claimant`): the claim
+// records the owner, a lease expiry and a fencing token. The owner renews its
+// leases with a heartbeat (`renew_leases`); every write on behalf of a
+// running job carries its `Claim` and is refused once another claim (a
+// takeover after the lease lapsed) or a dismissal has replaced it. Start-up
+// recovery only requeues jobs whose lease has lapsed, so it never takes the
+// jobs of another live process.
+//
+// Backends: the SQLite store (`open_sqlite_store`, one process per file,
+// server/src/store/sqlite/); a shared PostgreSQL store can sit beside it.
+// Every backend passes the contract suite in tests/server/store_contract.hpp.
+//
+// Domain outcomes (unknown job, queue full, idempotency conflict, lost claim)
+// are values; only a failing database (disk full, corrupt file, newer schema,
+// a file another process holds) throws StoreFailure, which the HTTP edge
+// turns into a 500 and start-up into exit 1.
 #pragma once
 
 #include <cstdint>
 #include <filesystem>
 #include <map>
 #include <memory>
-#include <mutex>
 #include <optional>
 #include <stdexcept>
 #include <string>
 #include <string_view>
 #include <vector>
 
-struct sqlite3;
+#include "hmpm/server/job_status.hpp"
 
 namespace hmpm::server {
-
-/// The contract's job states (OGC API – Processes status codes).
-enum class JobStatus { accepted, running, successful, failed, dismissed };
-
-/// "accepted", "running", ...
-const char* status_name(JobStatus status);
-/// Inverse of status_name; nullopt for anything else.
-std::optional<JobStatus> parse_status(std::string_view text);
-/// successful, failed and dismissed never change again (except dismissal).
-bool is_terminal(JobStatus status);
 
 /// A database failure the service cannot recover from by itself.
 class StoreFailure : public std::runtime_error {
@@ -74,6 +71,10 @@ struct JobRecord {
   std::string failure_reason;
   JobCost cost;
   double run_seconds = 0.0;  ///< wall time of the last attempt's run_job
+  // The claim of the last attempt (meaningful while running).
+  std::string owner;                  ///< instance id of the server running it
+  std::int64_t lease_token = 0;       ///< fencing token, raised by every claim
+  std::int64_t lease_expires_ms = 0;  ///< Unix time in ms; the claim lapses after it
 };
 
 /// A result file of a finished job: `<data-dir>/<job id>/<name>`.
@@ -114,73 +115,98 @@ struct RecoveryReport {
 /// Job count per status plus figures for /metrics.
 using StatusCounts = std::map<JobStatus, std::int64_t>;
 
+/// Who claims jobs: one running server process.
+struct Claimant {
+  std::string instance;   ///< unique per process (Service makes one at start-up)
+  double lease_s = 30.0;  ///< how long a claim holds without renewal
+};
+
+/// The right to write on behalf of one running job (from claim_next).
+struct Claim {
+  std::string job_id;
+  std::string owner;
+  std::int64_t token = 0;  ///< fencing token of this claim
+};
+
+/// The claim a claimed record carries.
+inline Claim claim_of(const JobRecord& job) {
+  return Claim{job.id, job.owner, job.lease_token};
+}
+
+/// What became of a write made with a claim.
+enum class ClaimState {
+  held,       ///< the claim is current: the write was applied
+  dismissed,  ///< the job was dismissed meanwhile: stop and remove its files
+  lost,       ///< another claim replaced this one (or the job ended): stop, touch nothing
+};
+
+/// The outcome of a finished attempt, as finish() records it.
+struct JobEnd {
+  JobStatus status = JobStatus::failed;  ///< successful or failed
+  std::string message;
+  std::string failure_reason;  ///< empty when successful
+  std::vector<ResultFile> files;
+  double run_seconds = 0.0;
+};
+
 class JobStore {
  public:
-  /// Opens (creating if needed) the database at `db_path` and migrates it to
-  /// the current schema. Throws StoreFailure when the file cannot be opened
-  /// or its schema is newer than this build knows.
-  explicit JobStore(const std::filesystem::path& db_path);
-  ~JobStore();
-  JobStore(const JobStore&) = delete;
-  JobStore& operator=(const JobStore&) = delete;
+  virtual ~JobStore() = default;
 
-  /// Schema version this build migrates to.
-  static int current_schema_version();
-  /// Schema version recorded in the file (PRAGMA user_version).
-  int schema_version();
+  /// Reads the store (a cheap probe for /health); throws StoreFailure if it cannot.
+  virtual void probe() = 0;
 
   /// Stores a new accepted job unless the queue holds `max_queue` accepted
   /// jobs already, or `job.idempotency_key` was used before (then the earlier
   /// job comes back as replayed or key_conflict). Atomic.
-  SubmitResult submit(const NewJob& job, std::int64_t max_queue);
+  virtual SubmitResult submit(const NewJob& job, std::int64_t max_queue) = 0;
 
-  std::optional<JobRecord> find(const std::string& id);
+  virtual std::optional<JobRecord> find(const std::string& id) = 0;
 
   /// Newest first; `statuses` empty means all.
-  std::vector<JobRecord> list(const std::vector<JobStatus>& statuses, int limit);
+  virtual std::vector<JobRecord> list(const std::vector<JobStatus>& statuses, int limit) = 0;
 
-  /// Takes the oldest accepted job: status running, attempts + 1, started now.
-  std::optional<JobRecord> claim_next();
+  /// Takes the oldest accepted job for `who`: status running, attempts + 1,
+  /// started now, owner = who.instance, lease until now + who.lease_s, a new
+  /// fencing token. nullopt when nothing waits.
+  virtual std::optional<JobRecord> claim_next(const Claimant& who) = 0;
 
-  /// Sets the progress (percent) of a running job. Returns false when the job
-  /// is no longer running (dismissed meanwhile), so the worker can stop.
-  bool update_progress(const std::string& id, double percent);
+  /// Extends the lease of every job `who` is running to now + who.lease_s.
+  /// Returns how many leases were renewed.
+  virtual std::int64_t renew_leases(const Claimant& who) = 0;
+
+  /// Sets the progress (percent) of a running job.
+  virtual ClaimState update_progress(const Claim& claim, double percent) = 0;
 
   /// Ends a running job as successful or failed with its result files.
-  /// Returns false (and records nothing) when the job is no longer running.
-  bool finish(const std::string& id, JobStatus status, const std::string& message,
-              const std::string& failure_reason, const std::vector<ResultFile>& files,
-              double run_seconds);
+  /// Records nothing unless the claim is held.
+  virtual ClaimState finish(const Claim& claim, const JobEnd& end) = 0;
 
   /// Puts a running job back in the queue (graceful shutdown). The attempt
   /// is not counted: the job did nothing wrong.
-  bool requeue(const std::string& id);
+  virtual ClaimState requeue(const Claim& claim) = 0;
 
   /// Dismisses a job in any state and forgets its result files. Returns the
   /// row as it was before (nullopt for an unknown id); already dismissed
   /// jobs stay as they are.
-  std::optional<JobRecord> dismiss(const std::string& id);
+  virtual std::optional<JobRecord> dismiss(const std::string& id) = 0;
 
-  std::vector<ResultFile> results(const std::string& id);
+  virtual std::vector<ResultFile> results(const std::string& id) = 0;
 
-  /// Start-up recovery: every job left `running` by a process that died goes
-  /// back to `accepted` while attempts < max_attempts, else to `failed` with
-  /// the reason. Call before any worker starts.
-  RecoveryReport recover(int max_attempts);
+  /// Recovery: every running job whose lease has lapsed goes back to
+  /// `accepted` while attempts < max_attempts, else to `failed` with the
+  /// reason. Jobs with a live lease are left alone, whoever owns them.
+  virtual RecoveryReport recover(int max_attempts) = 0;
 
-  StatusCounts count_by_status();
-
- private:
-  class Lease;
-  Lease lease();
-  void migrate();
-  void close_idle();
-  sqlite3* open_connection();
-  void release(sqlite3* db);
-
-  std::filesystem::path path_;
-  std::mutex pool_mutex_;
-  std::vector<sqlite3*> idle_;
+  virtual StatusCounts count_by_status() = 0;
 };
+
+/// Opens (creating if needed) the SQLite database at `db_path` for this
+/// process alone and migrates it to the current schema. Throws StoreFailure
+/// when the file cannot be opened, its schema is newer than this build
+/// knows, or another live process holds it (the message names its pid).
+/// Holding the file proves that no other process runs any job, so the leases
+/// of earlier processes end on open and recover() requeues their jobs.
+std::unique_ptr<JobStore> open_sqlite_store(const std::filesystem::path& db_path);
 
 }  // namespace hmpm::server

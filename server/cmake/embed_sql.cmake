@@ -1,0 +1,30 @@
+# embed_sql.cmake — turns the migration files NNNN_name.sql of SQL_DIR into a
+# C++ header (OUTPUT) holding them as raw string literals, in file-name order,
+# so the server never reads a migration from disk at run time.
+# Usage: cmake -DSQL_DIR=dir -DOUTPUT=file.hpp -P embed_sql.cmake
+file(GLOB files "${SQL_DIR}/*.sql")
+list(SORT files)
+set(text "// Generated from ${SQL_DIR} by server/cmake/embed_sql.cmake; do not edit.\n")
+string(APPEND text "#pragma once\n\nnamespace hmpm::server::sqlite {\n\n")
+string(APPEND text "struct Migration {\n  int version;\n  const char* name;\n  const char* sql;\n};\n\n")
+string(APPEND text "inline constexpr Migration migrations[] = {\n")
+foreach(file IN LISTS files)
+  get_filename_component(name "${file}" NAME_WE)
+  if(NOT name MATCHES "^([0-9]+)_")
+    message(FATAL_ERROR "migration ${file}: the name must start with its version, e.g. 0003_x.sql")
+  endif()
+  math(EXPR version "${CMAKE_MATCH_1}")
+  file(READ "${file}" sql)
+  if(sql MATCHES "\\)hmpm_sql\"")
+    message(FATAL_ERROR "migration ${file} contains the raw-string delimiter")
+  endif()
+  string(APPEND text "    {${version}, \"${name}\", R\"hmpm_sql(${sql})hmpm_sql\"},\n")
+endforeach()
+string(APPEND text "};\n\n}  // namespace hmpm::server::sqlite\n")
+# Rewrite only on change, so dependants are not rebuilt for nothing.
+if(EXISTS "${OUTPUT}")
+  file(READ "${OUTPUT}" old)
+endif()
+if(NOT old STREQUAL text)
+  file(WRITE "${OUTPUT}" "${text}")
+endif()

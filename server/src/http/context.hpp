@@ -1,0 +1,26 @@
+// context.hpp — what a request handler may use: the service's parts, by reference.
+//
+// Handlers are free functions of (Context&, request, response); they read
+// and write the store and nudge the workers, never run solver work.
+#pragma once
+
+#include <atomic>
+
+#include "hmpm/api/job.hpp"
+#include "hmpm/server/service.hpp"
+#include "hmpm/server/store.hpp"
+#include "metrics.hpp"
+#include "worker_pool.hpp"
+
+namespace hmpm::server::http {
+
+struct Context {
+  const ServiceConfig& config;
+  const hmpm::api::Limits& limits;
+  JobStore& store;
+  Metrics& metrics;
+  WorkerPool& workers;
+  const std::atomic<bool>& stopping;  ///< set by Service::stop()
+};
+
+}  // namespace hmpm::server::http

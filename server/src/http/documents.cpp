@@ -1,0 +1,55 @@
+// documents.cpp — see documents.hpp.
+#include "documents.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace hmpm::server::http {
+namespace {
+
+Json timestamp_or_null(const std::string& t) {
+  return t.empty() ? Json(nullptr) : Json(t);
+}
+
+}  // namespace
+
+int whole_percent(double progress) {
+  return static_cast<int>(std::clamp(std::floor(progress), 0.0, 100.0));
+}
+
+Json link(const std::string& href, const char* rel, const char* type, const char* title) {
+  return Json{{"href", href}, {"rel", rel}, {"type", type}, {"title", title}};
+}
+
+Json status_document(const JobRecord& job) {
+  const std::string self = "/jobs/" + job.id;
+  Json doc{{"jobID", job.id},
+           {"type", "process"},
+           {"processID", "hmpm"},
+           {"name", job.name},
+           {"status", status_name(job.status)},
+           {"progress", whole_percent(job.progress)},
+           {"message", job.message},
+           {"created", job.created},
+           {"started", timestamp_or_null(job.started)},
+           {"finished", timestamp_or_null(job.finished)},
+           {"updated", job.updated},
+           {"attempts", job.attempts}};
+  if (!job.failure_reason.empty()) doc["reason"] = job.failure_reason;
+  doc["cost"] = Json{{"particles", job.cost.particles},
+                     {"nodes", job.cost.nodes},
+                     {"cells", job.cost.cells},
+                     {"steps", job.cost.steps},
+                     {"dt", job.cost.dt},
+                     {"particle_steps", job.cost.particle_steps},
+                     {"memory_bytes", job.cost.memory_bytes},
+                     {"output_bytes", job.cost.output_bytes}};
+  if (job.run_seconds > 0) doc["run_seconds"] = job.run_seconds;
+  doc["links"] = Json::array(
+      {link(self, "self", "application/json", "this status document"),
+       link(self + "/results", "results", "application/json", "manifest of the result files"),
+       link(self + "/events", "events", "text/event-stream", "progress as Server-Sent Events")});
+  return doc;
+}
+
+}  // namespace hmpm::server::http

@@ -1,0 +1,34 @@
+// handlers.hpp — the request handlers, by resource; routes.cpp maps them to paths.
+//
+// Path parameters arrive in `req.matches` (1: job id, 2: result file name).
+// Authentication, 404 and 405 are the router's business, not theirs.
+#pragma once
+
+#include <httplib.h>
+
+#include <string>
+
+#include "context.hpp"
+
+namespace hmpm::server::http {
+
+// health.cpp — service state.
+void get_health(Context& c, const httplib::Request& req, httplib::Response& res);
+void get_metrics(Context& c, const httplib::Request& req, httplib::Response& res);
+
+// jobs.cpp — the job collection and one job.
+void post_job(Context& c, const httplib::Request& req, httplib::Response& res,
+              const std::string& body);
+void list_jobs(Context& c, const httplib::Request& req, httplib::Response& res);
+void get_job(Context& c, const httplib::Request& req, httplib::Response& res);
+void get_job_spec(Context& c, const httplib::Request& req, httplib::Response& res);
+void dismiss_job(Context& c, const httplib::Request& req, httplib::Response& res);
+
+// results.cpp — the manifest and the files of a finished job.
+void get_manifest(Context& c, const httplib::Request& req, httplib::Response& res);
+void get_result_file(Context& c, const httplib::Request& req, httplib::Response& res);
+
+// events.cpp — progress as Server-Sent Events.
+void stream_events(Context& c, const httplib::Request& req, httplib::Response& res);
+
+}  // namespace hmpm::server::http

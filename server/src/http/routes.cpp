@@ -1,0 +1,164 @@
+// routes.cpp — the route table of hmpm-server and the router that serves it.
+#include "routes.hpp"
+
+#include <array>
+#include <stdexcept>
+
+#include "handlers.hpp"
+#include "problem.hpp"
+
+namespace hmpm::server::http {
+namespace {
+
+const std::string job = "/jobs/([0-9a-f]{8}-[0-9a-f]{4}-[0-9a-f]{4}-[0-9a-f]{4}-[0-9a-f]{12})";
+
+constexpr std::array<Method, 5> all_methods{Method::get, Method::post, Method::put, Method::patch,
+                                            Method::del};
+
+}  // namespace
+
+std::vector<Route> route_table() {
+  return {
+      {Method::get, "/health", Access::open, get_health},
+      {Method::get, "/metrics", Access::token, get_metrics},
+      {Method::post, "/jobs", Access::token, post_job},
+      {Method::get, "/jobs", Access::token, list_jobs},
+      {Method::get, job, Access::token, get_job},
+      {Method::del, job, Access::token, dismiss_job},
+      {Method::get, job + "/spec", Access::token, get_job_spec},
+      {Method::get, job + "/results", Access::token, get_manifest},
+      {Method::get, job + "/results/(.+)", Access::token, get_result_file},
+      {Method::get, job + "/events", Access::token, stream_events},
+  };
+}
+
+const char* method_name(Method method) {
+  switch (method) {
+    case Method::get:
+      return "GET";
+    case Method::post:
+      return "POST";
+    case Method::put:
+      return "PUT";
+    case Method::patch:
+      return "PATCH";
+    case Method::del:
+      return "DELETE";
+  }
+  return "";
+}
+
+Router::Router(std::vector<Route> routes, Context& context, const Authenticator& auth)
+    : context_(context), auth_(auth) {
+  for (Route& r : routes) {
+    std::regex regex(r.pattern);
+    routes_.push_back({std::move(r), std::move(regex)});
+  }
+}
+
+bool Router::needs_token(const std::string& path) const {
+  for (const Compiled& c : routes_) {
+    if (c.route.access == Access::open && std::regex_match(path, c.regex)) return false;
+  }
+  return true;
+}
+
+std::string Router::allowed_methods(const std::string& path) const {
+  std::string allow;
+  for (Method m : all_methods) {
+    for (const Compiled& c : routes_) {
+      if (c.route.method != m || !std::regex_match(path, c.regex)) continue;
+      allow += (allow.empty() ? "" : ", ") + std::string(method_name(m));
+      if (m == Method::get) allow += ", HEAD";
+      break;
+    }
+  }
+  return allow;
+}
+
+void Router::answer_unrouted(const httplib::Request& req, httplib::Response& res) const {
+  const std::string allow = allowed_methods(req.path);
+  if (allow.empty()) return send_not_found(res, "no such resource: " + req.path);
+  res.set_header("Allow", allow);
+  send_problem(res, 405, "method-not-allowed", "Method not allowed",
+               req.method + " is not supported on " + req.path);
+}
+
+namespace {
+
+using PlainRegistrar = httplib::Server& (httplib::Server::*)(const std::string&,
+                                                             httplib::Server::Handler);
+using BodyRegistrar = httplib::Server& (
+    httplib::Server::*)(const std::string&, httplib::Server::HandlerWithContentReader);
+
+// httplib's registration function for `method`.
+PlainRegistrar plain_registrar(Method method) {
+  constexpr std::array<PlainRegistrar, 5> by_method{&httplib::Server::Get, &httplib::Server::Post,
+                                                    &httplib::Server::Put, &httplib::Server::Patch,
+                                                    &httplib::Server::Delete};
+  return by_method[static_cast<std::size_t>(method)];
+}
+
+// The same for handlers that read the body; null for GET and DELETE.
+BodyRegistrar body_registrar(Method method) {
+  constexpr std::array<BodyRegistrar, 5> by_method{
+      nullptr, &httplib::Server::Post, &httplib::Server::Put, &httplib::Server::Patch, nullptr};
+  return by_method[static_cast<std::size_t>(method)];
+}
+
+}  // namespace
+
+void Router::register_route(httplib::Server& server, const Compiled& c) const {
+  const Route& route = c.route;
+  const bool guarded = route.access == Access::token;
+  if (const auto* plain = std::get_if<Handler>(&route.handler)) {
+    (server.*plain_registrar(route.method))(
+        route.pattern,
+        [this, guarded, f = *plain](const httplib::Request& req, httplib::Response& res) {
+          // Requests with a body skipped the pre-routing check; check here.
+          if (guarded && !auth_.authorized(req)) return auth_.refuse(res);
+          f(context_, req, res);
+        });
+    return;
+  }
+  // A body route reads through a content reader: that bypasses httplib's
+  // own form parsing, which refuses `application/x-www-form-urlencoded`
+  // bodies (what `curl -d` sends) above 8 KiB.
+  const BodyRegistrar registrar = body_registrar(route.method);
+  if (!registrar)
+    throw std::logic_error("route " + route.pattern + ": GET and DELETE take no body");
+  (server.*registrar)(route.pattern, [this, guarded, f = std::get<BodyHandler>(route.handler)](
+                                         const httplib::Request& req, httplib::Response& res,
+                                         const httplib::ContentReader& reader) {
+    const std::size_t limit = context_.config.max_body_bytes;
+    std::string body;
+    bool too_large = false;
+    const bool complete = reader([&](const char* data, std::size_t n) {
+      if (body.size() + n > limit) {
+        too_large = true;
+        return false;
+      }
+      body.append(data, n);
+      return true;
+    });
+    if (!complete) {
+      if (too_large || res.status == 413) return send_too_large(res, limit);
+      return send_problem(res, 400, "bad-request", "Bad request",
+                          "the request body could not be read");
+    }
+    if (guarded && !auth_.authorized(req)) return auth_.refuse(res);
+    f(context_, req, res, body);
+  });
+}
+
+void Router::install(httplib::Server& server) const {
+  for (const Compiled& c : routes_) register_route(server, c);
+  // Anything else: 405 on a path some route serves, 404 elsewhere.
+  for (Method m : all_methods) {
+    (server.*plain_registrar(m))(".*", [this](const httplib::Request& req, httplib::Response& res) {
+      answer_unrouted(req, res);
+    });
+  }
+}
+
+}  // namespace hmpm::server::http

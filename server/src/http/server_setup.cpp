@@ -1,0 +1,133 @@
+// server_setup.cpp — see server_setup.hpp.
+#include "server_setup.hpp"
+
+#include <sys/socket.h>
+
+#include <charconv>
+#include <chrono>
+
+#include "job_log.hpp"
+#include "problem.hpp"
+
+namespace hmpm::server::http {
+namespace {
+
+using SteadyClock = std::chrono::steady_clock;
+
+// When the current request reached routing, for the log line's duration.
+thread_local SteadyClock::time_point request_start{};
+thread_local bool request_timed = false;
+
+std::optional<std::uint64_t> content_length(const httplib::Request& req) {
+  if (!req.has_header("Content-Length")) return std::nullopt;
+  const std::string v = req.get_header_value("Content-Length");
+  std::uint64_t n = 0;
+  const auto [end, ec] = std::from_chars(v.data(), v.data() + v.size(), n);
+  if (ec != std::errc() || end != v.data() + v.size()) return std::nullopt;
+  return n;
+}
+
+// SO_REUSEADDR only (a restart may bind while old connections sit in
+// TIME_WAIT); never SO_REUSEPORT, so a port in use stays in use.
+void socket_options(socket_t sock) {
+  int yes = 1;
+  setsockopt(sock, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof yes);
+}
+
+}  // namespace
+
+void configure_server(httplib::Server& http, Context& context, const Router& router,
+                      const Authenticator& auth) {
+  const ServiceConfig& config = context.config;
+  const auto http_threads = static_cast<std::size_t>(config.http_threads);
+  http.new_task_queue = [http_threads] { return new httplib::ThreadPool(http_threads); };
+  http.set_socket_options(socket_options);
+  http.set_payload_max_length(config.max_body_bytes);
+  http.set_keep_alive_timeout(2);  // bounds how long shutdown waits for idle connections
+  http.set_keep_alive_max_count(100);
+  // Headers and body go out in separate writes: without TCP_NODELAY, Nagle's
+  // algorithm and the client's delayed ACK add ~40 ms to every response.
+  http.set_tcp_nodelay(true);
+  http.set_read_timeout(10);
+
+  http.set_pre_routing_handler([&router, &auth](const httplib::Request& req,
+                                                httplib::Response& res) {
+    request_start = SteadyClock::now();
+    request_timed = true;
+    const bool body_method = req.method == "POST" || req.method == "PUT" || req.method == "PATCH";
+    if (req.has_header("Transfer-Encoding") || (body_method && !req.has_header("Content-Length"))) {
+      res.set_header("Connection", "close");
+      send_problem(res, 411, "length-required", "Length required",
+                   "send the body with a Content-Length header; chunked or unterminated bodies "
+                   "are not accepted");
+      return httplib::Server::HandlerResponse::Handled;
+    }
+    if (req.has_header("Content-Length") && !content_length(req)) {
+      res.set_header("Connection", "close");
+      send_problem(res, 400, "bad-request", "Bad request", "Content-Length is not a number");
+      return httplib::Server::HandlerResponse::Handled;
+    }
+    // Requests with a body are checked by the router once the body has been
+    // read, so an unread body is never left on a kept-alive connection.
+    if (content_length(req).value_or(0) == 0 && router.needs_token(req.path) &&
+        !auth.authorized(req)) {
+      auth.refuse(res);
+      return httplib::Server::HandlerResponse::Handled;
+    }
+    return httplib::Server::HandlerResponse::Unhandled;
+  });
+
+  // `Expect: 100-continue` (curl, for large bodies): refuse before the body is sent.
+  http.set_expect_100_continue_handler(
+      [&config, &router, &auth](const httplib::Request& req, httplib::Response& res) {
+        if (content_length(req).value_or(0) > config.max_body_bytes) {
+          send_too_large(res, config.max_body_bytes);
+          return 413;
+        }
+        if (router.needs_token(req.path) && !auth.authorized(req)) {
+          auth.refuse(res);
+          return 401;
+        }
+        return 100;
+      });
+
+  http.set_error_handler(
+      httplib::Server::HandlerWithResponse([](const httplib::Request&, httplib::Response& res) {
+        if (res.body.empty()) send_default_problem(res);
+        return httplib::Server::HandlerResponse::Handled;
+      }));
+
+  http.set_exception_handler([](const httplib::Request& req, httplib::Response& res,
+                                std::exception_ptr ep) {
+    std::string what = "unknown exception";
+    try {
+      std::rethrow_exception(std::move(ep));
+    } catch (const std::exception& e) {
+      what = e.what();
+    } catch (...) {
+    }
+    log_line({{"event", "error"}, {"method", req.method}, {"path", req.path}, {"detail", what}});
+    res = httplib::Response();
+    send_problem(res, 500, "internal-error", "Internal server error",
+                 "the server could not complete the request; its log has the details");
+  });
+
+  http.set_logger([&context](const httplib::Request& req, const httplib::Response& res) {
+    context.metrics.count_request(res.status);
+    Json line{{"event", "request"},
+              {"method", req.method},
+              {"path", req.path},
+              {"status", res.status},
+              {"remote", req.remote_addr}};
+    if (request_timed) {
+      line["ms"] =
+          std::chrono::duration<double, std::milli>(SteadyClock::now() - request_start).count();
+      request_timed = false;
+    }
+    log_line(std::move(line));
+  });
+
+  router.install(http);
+}
+
+}  // namespace hmpm::server::http

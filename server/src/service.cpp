@@ -1,0 +1,166 @@
+// service.cpp — the life cycle of hmpm-server: open, lock, recover, bind, serve, stop.
+//
+// Construction takes the data folder's lock and opens the store (which locks
+// the database) before anything is recovered or bound, so a second server on
+// the same `--db` or `--data-dir` fails here with the other one's pid. Each
+// process is one store instance (`instance_id`): its claims carry that id,
+// its heartbeat renews their leases. Requests are served by http/.
+#include <chrono>
+#include <thread>
+#include <utility>
+
+#include "digest.hpp"
+#include "hmpm/server/service.hpp"
+#include "hmpm/server/store.hpp"
+#include "http/server_setup.hpp"
+#include "job_log.hpp"
+#include "metrics.hpp"
+#include "process_lock.hpp"
+#include "worker_pool.hpp"
+
+namespace hmpm::server {
+namespace {
+
+using SteadyClock = std::chrono::steady_clock;
+
+// Fills in the defaults that depend on other settings and creates folders.
+ServiceConfig resolved(ServiceConfig c) {
+  if (c.data_dir.empty()) c.data_dir = c.db_path.parent_path() / "results";
+  if (c.threads_per_job <= 0) {
+    const int cores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+    c.threads_per_job = std::max(1, cores / std::max(1, c.workers));
+  }
+  if (!c.db_path.parent_path().empty())
+    std::filesystem::create_directories(c.db_path.parent_path());
+  std::filesystem::create_directories(c.data_dir);
+  return c;
+}
+
+hmpm::api::Limits limits_for(const ServiceConfig& c) {
+  hmpm::api::Limits limits;
+  limits.max_body_bytes = static_cast<std::int64_t>(c.max_body_bytes);
+  return limits;
+}
+
+WorkerSettings worker_settings(const ServiceConfig& c, const hmpm::api::Limits& limits,
+                               const std::string& instance) {
+  return WorkerSettings{.workers = c.workers,
+                        .threads_per_job = c.threads_per_job,
+                        .wall_time_limit_s = c.job_wall_time_s,
+                        .progress_interval_s = c.progress_interval_s,
+                        .data_dir = c.data_dir,
+                        .limits = limits,
+                        .claimant = Claimant{instance, c.lease_s},
+                        .lease_renewal_s = c.lease_s / 3.0};
+}
+
+void log_recovery(const RecoveryReport& recovery) {
+  for (const auto& id : recovery.requeued) {
+    log_line({{"event", "job"},
+              {"job", id},
+              {"status", status_name(JobStatus::accepted)},
+              {"recovered", true}});
+  }
+  for (const auto& id : recovery.failed) {
+    log_line({{"event", "job"},
+              {"job", id},
+              {"status", status_name(JobStatus::failed)},
+              {"recovered", true},
+              {"reason", "too many interrupted attempts"}});
+  }
+}
+
+}  // namespace
+
+struct Service::Impl {
+  explicit Impl(ServiceConfig c)
+      : config(resolved(std::move(c))),
+        data_lock(ProcessLock::hold(config.data_dir / ".hmpm-server.lock",
+                                    "data folder " + config.data_dir.string())),
+        limits(limits_for(config)),
+        store(open_sqlite_store(config.db_path)),
+        workers(*store, metrics, worker_settings(config, limits, instance_id)),
+        context{config, limits, *store, metrics, workers, stopping},
+        auth(config.token),
+        router(http::route_table(), context, auth) {
+    log_recovery(store->recover(config.max_attempts));
+    http::configure_server(server, context, router, auth);
+  }
+
+  ServiceConfig config;
+  ProcessLock data_lock;  ///< before the store: nothing is opened unless both locks are ours
+  hmpm::api::Limits limits;
+  std::string instance_id = new_uuid_v4();
+  std::unique_ptr<JobStore> store;
+  Metrics metrics;
+  WorkerPool workers;
+  std::atomic<bool> stopping{false};
+  http::Context context;
+  http::Authenticator auth;
+  http::Router router;
+  httplib::Server server;
+  int port = -1;
+  std::atomic<bool> run_started{false};
+  std::atomic<bool> run_finished{false};
+};
+
+Service::Service(ServiceConfig config) : impl_(std::make_unique<Impl>(std::move(config))) {}
+
+Service::~Service() {
+  stop();
+  impl_->workers.shutdown();
+}
+
+int Service::bind() {
+  Impl& s = *impl_;
+  if (s.config.port == 0) {
+    s.port = s.server.bind_to_any_port(s.config.host);
+  } else {
+    s.port = s.server.bind_to_port(s.config.host, s.config.port) ? s.config.port : -1;
+  }
+  if (s.port <= 0) s.port = -1;
+  return s.port;
+}
+
+bool Service::run() {
+  Impl& s = *impl_;
+  if (s.port < 0) return false;
+  s.run_started = true;
+  s.workers.start();
+  log_line({{"event", "start"},
+            {"host", s.config.host},
+            {"port", s.port},
+            {"workers", s.config.workers},
+            {"threads_per_job", s.config.threads_per_job},
+            {"db", s.config.db_path.string()},
+            {"data_dir", s.config.data_dir.string()},
+            {"instance", s.instance_id},
+            {"auth", !s.config.token.empty()}});
+  const bool ok = s.stopping || s.server.listen_after_bind();
+  s.workers.shutdown();  // running jobs go back to the queue
+  s.run_finished = true;
+  log_line({{"event", "stop"}});
+  return ok;
+}
+
+void Service::stop() {
+  Impl& s = *impl_;
+  s.stopping = true;
+  // stop() may race with run() starting to listen: give it a moment to be
+  // listening, so the listener it is about to open is closed too.
+  const auto until = SteadyClock::now() + std::chrono::seconds(2);
+  while (s.run_started && !s.run_finished && !s.server.is_running() && SteadyClock::now() < until) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  s.server.stop();
+}
+
+bool Service::is_running() const {
+  return impl_->server.is_running();
+}
+
+const ServiceConfig& Service::config() const {
+  return impl_->config;
+}
+
+}  // namespace hmpm::server

@@ -1,0 +1,363 @@
+// sqlite_store.cpp — see sqlite_store.hpp; the contract is in store.hpp.
+//
+// Status names in SQL come from the job-status table (`sql_name`), never
+// from literals. Every write on behalf of a running job matches its claim
+// (owner and fencing token); when it matches nothing, `claim_state` tells
+// dismissal from a lost claim.
+#include "sqlite_store.hpp"
+
+#include <chrono>
+#include <utility>
+
+#include "clock.hpp"
+#include "migrate.hpp"
+
+namespace hmpm::server::sqlite {
+namespace {
+
+// 'running', quoted for SQL.
+std::string sql_name(JobStatus status) {
+  return std::string("'") + status_name(status) + "'";
+}
+
+std::int64_t now_ms() {
+  return std::chrono::duration_cast<std::chrono::milliseconds>(
+             std::chrono::system_clock::now().time_since_epoch())
+      .count();
+}
+
+std::int64_t lease_until(const Claimant& who) {
+  return now_ms() + static_cast<std::int64_t>(who.lease_s * 1000.0);
+}
+
+constexpr const char* job_columns =
+    "id, seq, name, spec, status, progress, message, created, started, finished, updated, "
+    "attempts, failure_reason, cost_particles, cost_nodes, cost_cells, cost_steps, "
+    "cost_particle_steps, cost_memory_bytes, cost_output_bytes, cost_dt, run_seconds, "
+    "coalesce(owner, ''), lease_token, lease_expires_ms";
+
+JobRecord read_job(const Statement& s) {
+  JobRecord r;
+  r.id = s.text(0);
+  r.seq = s.integer(1);
+  r.name = s.text(2);
+  r.spec = s.text(3);
+  r.status = parse_status(s.text(4)).value_or(JobStatus::failed);
+  r.progress = s.real(5);
+  r.message = s.text(6);
+  r.created = s.text(7);
+  r.started = s.text(8);
+  r.finished = s.text(9);
+  r.updated = s.text(10);
+  r.attempts = static_cast<int>(s.integer(11));
+  r.failure_reason = s.text(12);
+  r.cost.particles = s.integer(13);
+  r.cost.nodes = s.integer(14);
+  r.cost.cells = s.integer(15);
+  r.cost.steps = s.integer(16);
+  r.cost.particle_steps = s.integer(17);
+  r.cost.memory_bytes = s.integer(18);
+  r.cost.output_bytes = s.integer(19);
+  r.cost.dt = s.real(20);
+  r.run_seconds = s.real(21);
+  r.owner = s.text(22);
+  r.lease_token = s.integer(23);
+  r.lease_expires_ms = s.integer(24);
+  return r;
+}
+
+std::optional<JobRecord> select_job(sqlite3* db, std::string_view key) {
+  Statement s(db, std::string("SELECT ") + job_columns + " FROM jobs WHERE id = ?1");
+  s.bind(1, key);
+  if (!s.step()) return std::nullopt;
+  return read_job(s);
+}
+
+// The condition a write of a running job must meet: its claim is current.
+const std::string claim_held =
+    "id = ?1 AND status = " + sql_name(JobStatus::running) + " AND owner = ?2 AND lease_token = ?3";
+
+void bind_claim(Statement& s, const Claim& claim) {
+  s.bind(1, claim.job_id).bind(2, claim.owner).bind(3, claim.token);
+}
+
+// Why a claimed write matched no row.
+ClaimState claim_state(sqlite3* db, const Claim& claim) {
+  const auto job = select_job(db, claim.job_id);
+  return job && job->status == JobStatus::dismissed ? ClaimState::dismissed : ClaimState::lost;
+}
+
+}  // namespace
+
+std::filesystem::path lock_path_for(const std::filesystem::path& db_path) {
+  return db_path.string() + ".lock";
+}
+
+SqliteStore::SqliteStore(const std::filesystem::path& db_path)
+    : lock_(ProcessLock::hold(lock_path_for(db_path), "database " + db_path.string())),
+      pool_(db_path) {
+  auto connection = pool_.lease();
+  sqlite3* db = connection.get();
+  migrate(db);
+  // The lock is ours, so no other process is running anything: every
+  // earlier claim is void and recover() may requeue its job.
+  WriteTransaction tx(db);
+  exec(db, ("UPDATE jobs SET lease_expires_ms = 0 WHERE status = " + sql_name(JobStatus::running))
+               .c_str());
+  tx.commit();
+}
+
+void SqliteStore::probe() {
+  auto db = pool_.lease();
+  recorded_version(db.get());
+}
+
+SubmitResult SqliteStore::submit(const NewJob& job, std::int64_t max_queue) {
+  auto connection = pool_.lease();
+  sqlite3* db = connection.get();
+  WriteTransaction tx(db);
+  if (!job.idempotency_key.empty()) {
+    Statement s(db, "SELECT id, body_sha256 FROM jobs WHERE idempotency_key = ?1");
+    s.bind(1, job.idempotency_key);
+    if (s.step()) {
+      const std::string earlier_id = s.text(0);
+      const bool same_body = s.text(1) == job.body_sha256;
+      auto earlier = select_job(db, earlier_id);
+      tx.commit();
+      return {same_body ? SubmitOutcome::replayed : SubmitOutcome::key_conflict,
+              std::move(*earlier)};
+    }
+  }
+  {
+    Statement s(db, "SELECT count(*) FROM jobs WHERE status = " + sql_name(JobStatus::accepted));
+    if (s.step() && s.integer(0) >= max_queue) return {SubmitOutcome::queue_full, {}};
+  }
+  const std::string now = now_rfc3339();
+  Statement s(
+      db,
+      "INSERT INTO jobs (id, name, spec, status, message, created, updated, idempotency_key, "
+      "body_sha256, cost_particles, cost_nodes, cost_cells, cost_steps, cost_particle_steps, "
+      "cost_memory_bytes, cost_output_bytes, cost_dt) VALUES (?1, ?2, ?3, ?15, "
+      "'queued', ?4, ?4, ?5, ?6, ?7, ?8, ?9, ?10, ?11, ?12, ?13, ?14)");
+  s.bind(1, job.id).bind(2, job.name).bind(3, job.spec).bind(4, now);
+  s.bind_or_null(5, job.idempotency_key).bind_or_null(6, job.body_sha256);
+  s.bind(7, job.cost.particles).bind(8, job.cost.nodes).bind(9, job.cost.cells);
+  s.bind(10, job.cost.steps).bind(11, job.cost.particle_steps).bind(12, job.cost.memory_bytes);
+  s.bind(13, job.cost.output_bytes).bind(14, job.cost.dt);
+  s.bind(15, status_name(JobStatus::accepted));
+  s.step();
+  auto created = select_job(db, job.id);
+  tx.commit();
+  return {SubmitOutcome::created, std::move(*created)};
+}
+
+std::optional<JobRecord> SqliteStore::find(const std::string& id) {
+  auto db = pool_.lease();
+  return select_job(db.get(), id);
+}
+
+std::vector<JobRecord> SqliteStore::list(const std::vector<JobStatus>& statuses, int limit) {
+  std::string sql = std::string("SELECT ") + job_columns + " FROM jobs";
+  if (!statuses.empty()) {
+    sql += " WHERE status IN (";
+    for (std::size_t i = 0; i < statuses.size(); ++i) {
+      if (i > 0) sql += ",";
+      sql += sql_name(statuses[i]);
+    }
+    sql += ")";
+  }
+  sql += " ORDER BY seq DESC LIMIT ?1";
+  auto db = pool_.lease();
+  Statement s(db.get(), sql);
+  s.bind(1, static_cast<std::int64_t>(limit));
+  std::vector<JobRecord> out;
+  while (s.step()) out.push_back(read_job(s));
+  return out;
+}
+
+std::optional<JobRecord> SqliteStore::claim_next(const Claimant& who) {
+  auto connection = pool_.lease();
+  sqlite3* db = connection.get();
+  WriteTransaction tx(db);
+  std::string id;
+  {
+    Statement s(db, "SELECT id FROM jobs WHERE status = " + sql_name(JobStatus::accepted) +
+                        " ORDER BY seq LIMIT 1");
+    if (!s.step()) return std::nullopt;
+    id = s.text(0);
+  }
+  const std::string now = now_rfc3339();
+  Statement s(db, "UPDATE jobs SET status = " + sql_name(JobStatus::running) +
+                      ", progress = 0, message = 'running', started = ?1, finished = NULL, "
+                      "updated = ?1, attempts = attempts + 1, owner = ?3, "
+                      "lease_token = lease_token + 1, lease_expires_ms = ?4 WHERE id = ?2");
+  s.bind(1, now).bind(2, id).bind(3, who.instance).bind(4, lease_until(who));
+  s.step();
+  auto job = select_job(db, id);
+  tx.commit();
+  return job;
+}
+
+std::int64_t SqliteStore::renew_leases(const Claimant& who) {
+  auto connection = pool_.lease();
+  sqlite3* db = connection.get();
+  WriteTransaction tx(db);
+  Statement s(db, "UPDATE jobs SET lease_expires_ms = ?1 WHERE owner = ?2 AND status = " +
+                      sql_name(JobStatus::running));
+  s.bind(1, lease_until(who)).bind(2, who.instance);
+  s.step();
+  const std::int64_t renewed = sqlite3_changes(db);
+  tx.commit();
+  return renewed;
+}
+
+ClaimState SqliteStore::update_progress(const Claim& claim, double percent) {
+  auto connection = pool_.lease();
+  sqlite3* db = connection.get();
+  WriteTransaction tx(db);
+  Statement s(db, "UPDATE jobs SET progress = ?4, updated = ?5 WHERE " + claim_held);
+  bind_claim(s, claim);
+  s.bind(4, percent).bind(5, now_rfc3339());
+  s.step();
+  const ClaimState state = sqlite3_changes(db) == 1 ? ClaimState::held : claim_state(db, claim);
+  tx.commit();
+  return state;
+}
+
+ClaimState SqliteStore::finish(const Claim& claim, const JobEnd& end) {
+  auto connection = pool_.lease();
+  sqlite3* db = connection.get();
+  WriteTransaction tx(db);
+  const std::string now = now_rfc3339();
+  {
+    Statement s(db,
+                "UPDATE jobs SET status = ?4, message = ?5, failure_reason = ?6, finished = ?7, "
+                "updated = ?7, run_seconds = ?8, progress = CASE WHEN ?4 = " +
+                    sql_name(JobStatus::successful) + " THEN 100 ELSE progress END WHERE " +
+                    claim_held);
+    bind_claim(s, claim);
+    s.bind(4, status_name(end.status)).bind(5, end.message).bind_or_null(6, end.failure_reason);
+    s.bind(7, now).bind(8, end.run_seconds);
+    s.step();
+    if (sqlite3_changes(db) != 1) return claim_state(db, claim);
+  }
+  {
+    Statement clear(db, "DELETE FROM results WHERE job_id = ?1");
+    clear.bind(1, claim.job_id);
+    clear.step();
+  }
+  for (const ResultFile& f : end.files) {
+    Statement s(
+        db,
+        "INSERT INTO results (job_id, name, size, sha256, media_type) VALUES (?1, ?2, ?3, ?4, ?5)");
+    s.bind(1, claim.job_id).bind(2, f.name).bind(3, f.size).bind(4, f.sha256).bind(5, f.media_type);
+    s.step();
+  }
+  tx.commit();
+  return ClaimState::held;
+}
+
+ClaimState SqliteStore::requeue(const Claim& claim) {
+  auto connection = pool_.lease();
+  sqlite3* db = connection.get();
+  WriteTransaction tx(db);
+  Statement s(db, "UPDATE jobs SET status = " + sql_name(JobStatus::accepted) +
+                      ", progress = 0, started = NULL, "
+                      "message = 'queued again: the server stopped while it ran', updated = ?4, "
+                      "attempts = max(attempts - 1, 0), lease_expires_ms = 0 WHERE " +
+                      claim_held);
+  bind_claim(s, claim);
+  s.bind(4, now_rfc3339());
+  s.step();
+  const ClaimState state = sqlite3_changes(db) == 1 ? ClaimState::held : claim_state(db, claim);
+  tx.commit();
+  return state;
+}
+
+std::optional<JobRecord> SqliteStore::dismiss(const std::string& id) {
+  auto connection = pool_.lease();
+  sqlite3* db = connection.get();
+  WriteTransaction tx(db);
+  auto before = select_job(db, id);
+  if (!before || before->status == JobStatus::dismissed) return before;
+  {
+    Statement s(db, "UPDATE jobs SET status = " + sql_name(JobStatus::dismissed) +
+                        ", message = 'dismissed by the client', "
+                        "finished = coalesce(finished, ?1), updated = ?1 WHERE id = ?2");
+    s.bind(1, now_rfc3339()).bind(2, id);
+    s.step();
+  }
+  Statement clear(db, "DELETE FROM results WHERE job_id = ?1");
+  clear.bind(1, id);
+  clear.step();
+  tx.commit();
+  return before;
+}
+
+std::vector<ResultFile> SqliteStore::results(const std::string& id) {
+  auto db = pool_.lease();
+  Statement s(db.get(),
+              "SELECT name, size, sha256, media_type FROM results WHERE job_id = ?1 ORDER BY name");
+  s.bind(1, id);
+  std::vector<ResultFile> out;
+  while (s.step()) out.push_back({s.text(0), s.integer(1), s.text(2), s.text(3)});
+  return out;
+}
+
+RecoveryReport SqliteStore::recover(int max_attempts) {
+  auto connection = pool_.lease();
+  sqlite3* db = connection.get();
+  WriteTransaction tx(db);
+  std::vector<std::pair<std::string, int>> lapsed;
+  {
+    Statement s(db, "SELECT id, attempts FROM jobs WHERE status = " + sql_name(JobStatus::running) +
+                        " AND lease_expires_ms <= ?1 ORDER BY seq");
+    s.bind(1, now_ms());
+    while (s.step()) lapsed.emplace_back(s.text(0), static_cast<int>(s.integer(1)));
+  }
+  RecoveryReport report;
+  const std::string now = now_rfc3339();
+  for (const auto& [id, attempts] : lapsed) {
+    if (attempts < max_attempts) {
+      Statement s(db,
+                  "UPDATE jobs SET status = " + sql_name(JobStatus::accepted) +
+                      ", progress = 0, started = NULL, updated = ?1, "
+                      "message = 'queued again: the server stopped while it ran' WHERE id = ?2");
+      s.bind(1, now).bind(2, id);
+      s.step();
+      report.requeued.push_back(id);
+    } else {
+      const std::string reason = "the server stopped while this job ran, " +
+                                 std::to_string(attempts) + " times (limit " +
+                                 std::to_string(max_attempts) + " attempts); not retried";
+      Statement s(db, "UPDATE jobs SET status = " + sql_name(JobStatus::failed) +
+                          ", message = ?1, failure_reason = ?1, finished = ?2, updated = ?2 "
+                          "WHERE id = ?3");
+      s.bind(1, reason).bind(2, now).bind(3, id);
+      s.step();
+      report.failed.push_back(id);
+    }
+  }
+  tx.commit();
+  return report;
+}
+
+StatusCounts SqliteStore::count_by_status() {
+  auto db = pool_.lease();
+  Statement s(db.get(), "SELECT status, count(*) FROM jobs GROUP BY status");
+  StatusCounts counts;
+  while (s.step()) {
+    if (auto status = parse_status(s.text(0))) counts[*status] = s.integer(1);
+  }
+  return counts;
+}
+
+}  // namespace hmpm::server::sqlite
+
+namespace hmpm::server {
+
+std::unique_ptr<JobStore> open_sqlite_store(const std::filesystem::path& db_path) {
+  return std::make_unique<sqlite::SqliteStore>(db_path);
+}
+
+}  // namespace hmpm::server

@@ -1,0 +1,47 @@
+// sqlite_store.hpp — the JobStore on one SQLite file, for one process.
+//
+// The embedded default: WAL, synchronous=FULL (a 201 means the row is on
+// disk), writes in BEGIN IMMEDIATE transactions with a busy timeout so
+// concurrent writers queue instead of failing with SQLITE_BUSY. The file is
+// locked for the store's lifetime (`<db>.lock`, see process_lock.hpp): a
+// second process on the same file is refused on open, so the leases of every
+// earlier process are void and end as soon as the lock is ours.
+#pragma once
+
+#include <filesystem>
+#include <optional>
+
+#include "connection.hpp"
+#include "hmpm/server/store.hpp"
+#include "process_lock.hpp"
+
+namespace hmpm::server::sqlite {
+
+class SqliteStore final : public JobStore {
+ public:
+  /// See open_sqlite_store in store.hpp.
+  explicit SqliteStore(const std::filesystem::path& db_path);
+
+  void probe() override;
+  SubmitResult submit(const NewJob& job, std::int64_t max_queue) override;
+  std::optional<JobRecord> find(const std::string& id) override;
+  std::vector<JobRecord> list(const std::vector<JobStatus>& statuses, int limit) override;
+  std::optional<JobRecord> claim_next(const Claimant& who) override;
+  std::int64_t renew_leases(const Claimant& who) override;
+  ClaimState update_progress(const Claim& claim, double percent) override;
+  ClaimState finish(const Claim& claim, const JobEnd& end) override;
+  ClaimState requeue(const Claim& claim) override;
+  std::optional<JobRecord> dismiss(const std::string& id) override;
+  std::vector<ResultFile> results(const std::string& id) override;
+  RecoveryReport recover(int max_attempts) override;
+  StatusCounts count_by_status() override;
+
+ private:
+  ProcessLock lock_;  ///< taken first, released last
+  ConnectionPool pool_;
+};
+
+/// The lock file of the database at `db_path`: `<db_path>.lock`.
+std::filesystem::path lock_path_for(const std::filesystem::path& db_path);
+
+}  // namespace hmpm::server::sqlite

@@ -1,0 +1,289 @@
+// store_contract.cpp — the JobStore contract: FIFO claiming with owner,
+// lease and fencing token; progress and results only under a held claim;
+// idempotency keys; the queue cap; dismissal races; recovery that takes only
+// lapsed leases; durability across reopen; concurrent writers.
+#include "store_contract.hpp"
+
+#include <atomic>
+#include <thread>
+#include <vector>
+
+#include "support.hpp"
+
+namespace hmpm::server::testing {
+
+void StoreContract::SetUp() {
+  scratch_ = make_temp_dir("store-" + GetParam().name);
+}
+
+void StoreContract::TearDown() {
+  store_.reset();
+  std::filesystem::remove_all(scratch_);
+}
+
+JobStore& StoreContract::store() {
+  if (!store_) store_ = GetParam().open(scratch_);
+  return *store_;
+}
+
+void StoreContract::close() {
+  store_.reset();
+}
+
+NewJob StoreContract::job(const std::string& name, const std::string& key,
+                          const std::string& body_hash) {
+  static std::atomic<int> counter{0};
+  NewJob j;
+  j.id = "00000000-0000-4000-8000-" + std::to_string(100000000000 + counter++);
+  j.name = name;
+  j.spec = "{\"name\":\"" + name + "\"}";
+  j.cost.particles = 13;
+  j.cost.steps = 500;
+  j.idempotency_key = key;
+  j.body_sha256 = body_hash;
+  return j;
+}
+
+Claimant StoreContract::live() {
+  return Claimant{"live-instance", 600.0};
+}
+
+Claimant StoreContract::dead(const std::string& instance) {
+  return Claimant{instance, 0.0};
+}
+
+namespace {
+
+TEST_P(StoreContract, ReopeningKeepsJobs) {
+  const std::string id = store().submit(job("kept"), 10).job.id;
+  close();
+  const auto found = store().find(id);
+  ASSERT_TRUE(found);
+  EXPECT_EQ(found->name, "kept");
+  EXPECT_EQ(found->status, JobStatus::accepted);
+  EXPECT_EQ(found->cost.particles, 13);
+  EXPECT_FALSE(found->created.empty());
+  EXPECT_NO_THROW(store().probe());
+}
+
+TEST_P(StoreContract, ClaimsInSubmissionOrderWithOwnerLeaseAndToken) {
+  const auto a = store().submit(job("a"), 10).job.id;
+  const auto b = store().submit(job("b"), 10).job.id;
+  const auto first = store().claim_next(live());
+  ASSERT_TRUE(first);
+  EXPECT_EQ(first->id, a);
+  EXPECT_EQ(first->status, JobStatus::running);
+  EXPECT_EQ(first->attempts, 1);
+  EXPECT_FALSE(first->started.empty());
+  EXPECT_EQ(first->owner, live().instance);
+  EXPECT_GT(first->lease_token, 0);
+  EXPECT_GT(first->lease_expires_ms, 0);
+  EXPECT_EQ(store().claim_next(live())->id, b);
+  EXPECT_FALSE(store().claim_next(live()));
+}
+
+TEST_P(StoreContract, ProgressAndFinishApplyOnlyUnderAHeldClaim) {
+  const auto id = store().submit(job("p"), 10).job.id;
+  const Claim never{id, live().instance, 1};
+  EXPECT_NE(store().update_progress(never, 10), ClaimState::held);  // still accepted
+  const Claim claim = claim_of(*store().claim_next(live()));
+  EXPECT_EQ(store().update_progress(claim, 42.5), ClaimState::held);
+  EXPECT_DOUBLE_EQ(store().find(id)->progress, 42.5);
+  const JobEnd end{JobStatus::successful,
+                   "finished",
+                   "",
+                   {{"summary.json", 12, std::string(64, 'a'), "application/json"}},
+                   1.5};
+  EXPECT_EQ(store().finish(claim, end), ClaimState::held);
+  const auto done = store().find(id);
+  EXPECT_EQ(done->status, JobStatus::successful);
+  EXPECT_DOUBLE_EQ(done->progress, 100.0);
+  EXPECT_FALSE(done->finished.empty());
+  ASSERT_EQ(store().results(id).size(), 1u);
+  EXPECT_EQ(store().results(id)[0].size, 12);
+  EXPECT_EQ(store().finish(claim, JobEnd{JobStatus::failed, "again", "again", {}, 0}),
+            ClaimState::lost);
+}
+
+TEST_P(StoreContract, DismissingARunningJobTurnsItsClaimedWritesIntoDismissed) {
+  const auto id = store().submit(job("d"), 10).job.id;
+  const Claim claim = claim_of(*store().claim_next(live()));
+  const auto before = store().dismiss(id);
+  ASSERT_TRUE(before);
+  EXPECT_EQ(before->status, JobStatus::running);
+  EXPECT_EQ(store().find(id)->status, JobStatus::dismissed);
+  EXPECT_EQ(store().update_progress(claim, 50), ClaimState::dismissed);
+  EXPECT_EQ(store().finish(claim, JobEnd{JobStatus::successful, "finished", "", {}, 1}),
+            ClaimState::dismissed);
+  EXPECT_EQ(store().find(id)->status, JobStatus::dismissed);
+  EXPECT_EQ(store().dismiss(id)->status, JobStatus::dismissed);  // idempotent
+  EXPECT_FALSE(store().dismiss("00000000-0000-4000-8000-000000000000"));
+}
+
+TEST_P(StoreContract, IdempotencyKeyReplaysSameBodyAndRejectsAnother) {
+  const auto first = store().submit(job("i", "key-1", "hash-a"), 10);
+  EXPECT_EQ(first.outcome, SubmitOutcome::created);
+  const auto again = store().submit(job("i", "key-1", "hash-a"), 10);
+  EXPECT_EQ(again.outcome, SubmitOutcome::replayed);
+  EXPECT_EQ(again.job.id, first.job.id);
+  const auto other = store().submit(job("i", "key-1", "hash-b"), 10);
+  EXPECT_EQ(other.outcome, SubmitOutcome::key_conflict);
+  EXPECT_EQ(store().list({}, 10).size(), 1u);
+}
+
+TEST_P(StoreContract, QueueCapCountsOnlyWaitingJobs) {
+  EXPECT_EQ(store().submit(job("q1"), 2).outcome, SubmitOutcome::created);
+  EXPECT_EQ(store().submit(job("q2"), 2).outcome, SubmitOutcome::created);
+  EXPECT_EQ(store().submit(job("q3"), 2).outcome, SubmitOutcome::queue_full);
+  store().claim_next(live());  // one leaves the queue
+  EXPECT_EQ(store().submit(job("q4"), 2).outcome, SubmitOutcome::created);
+}
+
+// The fix of the two-servers-on-one-database data loss, at the store level:
+// recovery must leave a job alone while its owner's lease is live.
+TEST_P(StoreContract, RecoveryDoesNotRequeueAJobWhoseLeaseIsLive) {
+  const auto id = store().submit(job("owned"), 10).job.id;
+  const auto claimed = store().claim_next(live());
+  const auto report = store().recover(3);
+  EXPECT_TRUE(report.requeued.empty());
+  EXPECT_TRUE(report.failed.empty());
+  const auto job = store().find(id);
+  EXPECT_EQ(job->status, JobStatus::running);
+  EXPECT_EQ(job->owner, live().instance);
+  EXPECT_EQ(store().update_progress(claim_of(*claimed), 5), ClaimState::held);
+}
+
+TEST_P(StoreContract, RenewedLeasesStayLiveAndOnlyTheOwnersAreRenewed) {
+  const auto mine = store().submit(job("mine"), 10).job.id;
+  const auto theirs = store().submit(job("theirs"), 10).job.id;
+  store().claim_next(dead("me"));
+  store().claim_next(dead("them"));
+  EXPECT_EQ(store().renew_leases(Claimant{"me", 600.0}), 1);
+  const auto report = store().recover(3);
+  ASSERT_EQ(report.requeued.size(), 1u);
+  EXPECT_EQ(report.requeued[0], theirs);
+  EXPECT_EQ(store().find(mine)->status, JobStatus::running);
+  EXPECT_EQ(store().find(theirs)->status, JobStatus::accepted);
+}
+
+TEST_P(StoreContract, ATakenOverJobRefusesTheWritesOfItsEarlierClaim) {
+  const auto id = store().submit(job("taken-over"), 10).job.id;
+  const Claim stale = claim_of(*store().claim_next(dead("paused")));
+  ASSERT_EQ(store().recover(3).requeued.size(), 1u);
+  const Claim current = claim_of(*store().claim_next(live()));
+  EXPECT_GT(current.token, stale.token);
+  EXPECT_EQ(store().update_progress(stale, 99), ClaimState::lost);
+  EXPECT_EQ(store().finish(stale, JobEnd{JobStatus::failed, "late", "late", {}, 1}),
+            ClaimState::lost);
+  EXPECT_EQ(store().requeue(stale), ClaimState::lost);
+  EXPECT_EQ(store().find(id)->status, JobStatus::running);
+  EXPECT_EQ(store().find(id)->owner, live().instance);
+  EXPECT_EQ(store().finish(current, JobEnd{JobStatus::successful, "finished", "", {}, 1}),
+            ClaimState::held);
+}
+
+TEST_P(StoreContract, RecoveryRequeuesLapsedJobsUntilTheAttemptLimit) {
+  const std::string id = store().submit(job("crashy"), 10).job.id;
+  store().submit(job("waiting"), 10);
+  for (int attempt = 1; attempt <= 3; ++attempt) {
+    const auto report = store().recover(3);  // a new process starts
+    if (attempt > 1) {
+      ASSERT_EQ(report.requeued.size(), 1u);
+      EXPECT_EQ(report.requeued[0], id);
+    }
+    const auto claimed = store().claim_next(dead());
+    ASSERT_TRUE(claimed);
+    EXPECT_EQ(claimed->id, id);  // FIFO: the interrupted job keeps its place
+    EXPECT_EQ(claimed->attempts, attempt);
+    // ... and the process dies here, leaving the job running with its lease lapsing.
+  }
+  const auto report = store().recover(3);
+  EXPECT_TRUE(report.requeued.empty());
+  ASSERT_EQ(report.failed.size(), 1u);
+  const auto failed = store().find(id);
+  EXPECT_EQ(failed->status, JobStatus::failed);
+  EXPECT_NE(failed->failure_reason.find("3 times"), std::string::npos) << failed->failure_reason;
+  EXPECT_FALSE(failed->finished.empty());
+  EXPECT_EQ(store().count_by_status()[JobStatus::accepted], 1);  // the other job still waits
+  EXPECT_EQ(store().count_by_status().count(JobStatus::running), 0u);
+}
+
+TEST_P(StoreContract, GracefulRequeueDoesNotCountTheAttempt) {
+  const auto id = store().submit(job("r"), 10).job.id;
+  const Claim claim = claim_of(*store().claim_next(live()));
+  EXPECT_EQ(store().requeue(claim), ClaimState::held);
+  const auto back = store().find(id);
+  EXPECT_EQ(back->status, JobStatus::accepted);
+  EXPECT_EQ(back->attempts, 0);
+  EXPECT_TRUE(back->started.empty());
+  EXPECT_EQ(store().requeue(claim), ClaimState::lost);  // not running any more
+}
+
+TEST_P(StoreContract, ListFiltersByStatusNewestFirst) {
+  const auto a = store().submit(job("a"), 10).job.id;
+  const auto b = store().submit(job("b"), 10).job.id;
+  const auto c = store().submit(job("c"), 10).job.id;
+  store().claim_next(live());  // a runs
+  const auto all = store().list({}, 10);
+  ASSERT_EQ(all.size(), 3u);
+  EXPECT_EQ(all[0].id, c);
+  EXPECT_EQ(store().list({}, 2).size(), 2u);
+  const auto waiting = store().list({JobStatus::accepted}, 10);
+  ASSERT_EQ(waiting.size(), 2u);
+  EXPECT_EQ(waiting[1].id, b);
+  EXPECT_EQ(store().list({JobStatus::running, JobStatus::failed}, 10).at(0).id, a);
+}
+
+TEST_P(StoreContract, EveryStatusOfTheTableIsStoredAndCounted) {
+  // One job per row of job_statuses, each driven there through the interface.
+  const auto ok = store().submit(job("successful"), 10).job.id;
+  const auto bad = store().submit(job("failed"), 10).job.id;
+  const auto running = store().submit(job("running"), 10).job.id;
+  store().submit(job("accepted"), 10);
+  store().dismiss(store().submit(job("dismissed"), 10).job.id);
+  const Claim c_ok = claim_of(*store().claim_next(live()));
+  const Claim c_bad = claim_of(*store().claim_next(live()));
+  const auto c_running = store().claim_next(live());
+  ASSERT_EQ(c_ok.job_id, ok);
+  ASSERT_EQ(c_bad.job_id, bad);
+  ASSERT_EQ(c_running->id, running);
+  store().finish(c_ok, JobEnd{JobStatus::successful, "finished", "", {}, 1});
+  store().finish(c_bad, JobEnd{JobStatus::failed, "boom", "boom", {}, 1});
+  const auto counts = store().count_by_status();
+  for (const auto& row : job_statuses) {
+    EXPECT_EQ(counts.count(row.status) ? counts.at(row.status) : 0, 1) << row.name;
+    const auto listed = store().list({row.status}, 10);
+    ASSERT_EQ(listed.size(), 1u) << row.name;
+    EXPECT_EQ(listed[0].name, row.name);
+  }
+}
+
+TEST_P(StoreContract, ConcurrentWritersNeverFail) {
+  constexpr int threads = 8;
+  constexpr int per_thread = 40;
+  JobStore& s = store();
+  std::vector<std::thread> pool;
+  std::atomic<int> failures{0};
+  for (int t = 0; t < threads; ++t) {
+    pool.emplace_back([&, t] {
+      for (int i = 0; i < per_thread; ++i) {
+        try {
+          NewJob j = job("concurrent");
+          j.id = "10000000-0000-4000-8000-";
+          j.id += std::to_string(100000000000 + t * 1000 + i);
+          s.submit(j, 100000);
+          if (auto claimed = s.claim_next(live())) s.update_progress(claim_of(*claimed), 1);
+          s.list({}, 5);
+        } catch (const StoreFailure&) {
+          ++failures;
+        }
+      }
+    });
+  }
+  for (auto& t : pool) t.join();
+  EXPECT_EQ(failures, 0);
+  EXPECT_EQ(s.list({}, 1000).size(), static_cast<std::size_t>(threads * per_thread));
+}
+
+}  // namespace
+}  // namespace hmpm::server::testing
