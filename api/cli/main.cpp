@@ -2,10 +2,10 @@
 //
 //   hmpm run SPEC.json --out DIR [--threads N] [--quiet]
 //   hmpm validate SPEC.json
-// SPEC may be "-" for standard input. Exit codes follow the contract:
-// 0 success, 2 invalid spec (every error on stderr as "/pointer: message"),
-// 3 run failed (reason on stderr and in DIR/summary.json); 1 for a bad
-// command line or an unreadable file.
+// SPEC may be "-" for standard input. Exit codes (hmpm/api/exit_codes.hpp)
+// follow the contract: 0 success, 2 invalid spec (every error on stderr as
+// "/pointer: message"), 3 run failed (reason on stderr and in
+// DIR/summary.json); 1 for a bad command line or an unreadable file.
 #include <unistd.h>
 
 #include <algorithm>
@@ -21,14 +21,17 @@
 #include <thread>
 #include <vector>
 
+#include "hmpm/api/exit_codes.hpp"
 #include "hmpm/api/job.hpp"
 
 namespace {
 
-constexpr int kExitOk = 0;
-constexpr int kExitUsage = 1;
-constexpr int kExitInvalid = 2;
-constexpr int kExitRunFailed = 3;
+using hmpm::api::ExitCode;
+using hmpm::api::exit_status;
+constexpr int kExitOk = exit_status(ExitCode::ok);
+constexpr int kExitUsage = exit_status(ExitCode::usage);
+constexpr int kExitInvalid = exit_status(ExitCode::invalid_spec);
+constexpr int kExitRunFailed = exit_status(ExitCode::run_failed);
 
 std::atomic<bool> g_cancel{false};
 
