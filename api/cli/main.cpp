@@ -26,8 +26,8 @@
 
 namespace {
 
-using hmpm::api::ExitCode;
 using hmpm::api::exit_status;
+using hmpm::api::ExitCode;
 constexpr int kExitOk = exit_status(ExitCode::ok);
 constexpr int kExitUsage = exit_status(ExitCode::usage);
 constexpr int kExitInvalid = exit_status(ExitCode::invalid_spec);
@@ -43,7 +43,7 @@ const char* const kUsage =
     "usage:\n"
     "  hmpm run SPEC.json --out DIR [--threads N]   run a job locally, write results into DIR\n"
     "  hmpm validate SPEC.json                      check a job spec, print its cost estimate\n"
-    "  hmpm spec-keys                               print the keys the parser accepts (JSON)\n"
+    "  hmpm spec-keys                               print the parser's tables (JSON)\n"
     "  hmpm --help | --version\n"
     "SPEC may be '-' for standard input.\n"
     "Exit codes: 0 success; 2 invalid spec (one '/json/pointer: message' line per problem\n"
@@ -107,7 +107,8 @@ int command_validate(const std::vector<std::string>& args) {
   if (const int rc = load(args[0], result); rc != kExitOk) return rc;
   std::cout << "valid: " << result.job->name << "\n";
   print_cost(result.job->cost);
-  for (const auto& w : result.job->warnings) std::cerr << "hmpm: warning: " << w.path << ": " << w.message << "\n";
+  for (const auto& w : result.job->warnings)
+    std::cerr << "hmpm: warning: " << w.path << ": " << w.message << "\n";
   return kExitOk;
 }
 
@@ -179,16 +180,7 @@ int command_run(const std::vector<std::string>& args) {
 }
 
 int command_spec_keys() {
-  std::cout << "{";
-  bool first = true;
-  for (const auto& entry : hmpm::api::spec_object_keys()) {
-    std::cout << (first ? "\n" : ",\n") << "  \"" << entry.location << "\": [";
-    for (std::size_t i = 0; i < entry.keys.size(); ++i)
-      std::cout << (i ? ", " : "") << '"' << entry.keys[i] << '"';
-    std::cout << "]";
-    first = false;
-  }
-  std::cout << "\n}\n";
+  std::cout << hmpm::api::spec_tables_json();
   return kExitOk;
 }
 

@@ -59,8 +59,12 @@ constexpr bool field_table_is_in_enum_order() {
 }
 static_assert(field_table_is_in_enum_order(), "field_table rows must follow the Field enumerators");
 
+/// What field_info gives for a value outside the enumerators: "?", one component.
+inline constexpr FieldInfo unknown_field{Field::position, "?", FieldKind::scalar};
+
 constexpr const FieldInfo& field_info(Field f) {
-  return field_table[static_cast<std::size_t>(f)];
+  const auto i = static_cast<std::size_t>(f);
+  return i < field_table.size() ? field_table[i] : unknown_field;
 }
 
 /// Components of a kind in `dim` dimensions (vectors: dim; tensors: 6; scalars: 1).
