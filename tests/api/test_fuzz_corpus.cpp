@@ -5,8 +5,10 @@
 // holds it to that; every error carries a pointer-shaped path.
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include "hmpm/api/job.hpp"
 #include "test_support.hpp"
@@ -62,6 +64,21 @@ TEST(FuzzCorpus, EveryInputIsWhatItsNameSays) {
   }
   EXPECT_GE(valid, 3);     // the examples
   EXPECT_GE(rejected, 3);  // the malformed seeds
+}
+
+// fuzz/spec.dict keeps mutations close to real specs: it must name every key
+// and every enumerated value of the parser's tables (hmpm spec-keys).
+TEST(FuzzCorpus, DictionaryNamesEveryKeyAndValueOfTheParser) {
+  const std::string dict = testing::read_text(testing::source_path("fuzz/spec.dict"));
+  const nlohmann::json tables = nlohmann::json::parse(spec_tables_json());
+  std::vector<std::string> words;
+  for (const auto& [location, keys] : tables["objects"].items())
+    for (const auto& k : keys) words.push_back(k.get<std::string>());
+  for (const auto& [location, values] : tables["values"].items())
+    for (const auto& v : values) words.push_back(v.get<std::string>());
+  for (const std::string& w : words)
+    EXPECT_NE(dict.find("\"\\\"" + w + "\\\"\""), std::string::npos)
+        << "fuzz/spec.dict has no entry for \"" << w << "\"";
 }
 
 }  // namespace
