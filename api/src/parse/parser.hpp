@@ -8,8 +8,8 @@
 // sections share (boxes, selections, formulas). Every reader records its
 // problems in the ParseContext's SpecReader with their JSON pointers and
 // fills the Problem as it goes. checks.cpp then runs the checks that need
-// the whole Problem, and locations.cpp turns the solver's issue locations
-// into JSON pointers.
+// the whole Problem, locations.cpp turns the solver's issue locations into
+// JSON pointers, and tables.cpp prints every table for `hmpm spec-keys`.
 #pragma once
 
 #include <map>
