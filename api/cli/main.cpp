@@ -2,10 +2,10 @@
 //
 //   hmpm run SPEC.json --out DIR [--threads N] [--quiet]
 //   hmpm validate SPEC.json
-// SPEC may be "-" for standard input. Exit codes follow the contract:
-// 0 success, 2 invalid spec (every error on stderr as "/pointer: message"),
-// 3 run failed (reason on stderr and in DIR/summary.json); 1 for a bad
-// command line or an unreadable file.
+// SPEC may be "-" for standard input. Exit codes (hmpm/api/exit_codes.hpp)
+// follow the contract: 0 success, 2 invalid spec (every error on stderr as
+// "/pointer: message"), 3 run failed (reason on stderr and in
+// DIR/summary.json); 1 for a bad command line or an unreadable file.
 #include <unistd.h>
 
 #include <algorithm>
@@ -21,14 +21,17 @@
 #include <thread>
 #include <vector>
 
+#include "hmpm/api/exit_codes.hpp"
 #include "hmpm/api/job.hpp"
 
 namespace {
 
-constexpr int kExitOk = 0;
-constexpr int kExitUsage = 1;
-constexpr int kExitInvalid = 2;
-constexpr int kExitRunFailed = 3;
+using hmpm::api::exit_status;
+using hmpm::api::ExitCode;
+constexpr int kExitOk = exit_status(ExitCode::ok);
+constexpr int kExitUsage = exit_status(ExitCode::usage);
+constexpr int kExitInvalid = exit_status(ExitCode::invalid_spec);
+constexpr int kExitRunFailed = exit_status(ExitCode::run_failed);
 
 std::atomic<bool> g_cancel{false};
 
@@ -40,7 +43,7 @@ const char* const kUsage =
     "usage:\n"
     "  hmpm run SPEC.json --out DIR [--threads N]   run a job locally, write results into DIR\n"
     "  hmpm validate SPEC.json                      check a job spec, print its cost estimate\n"
-    "  hmpm spec-keys                               print the keys the parser accepts (JSON)\n"
+    "  hmpm spec-keys                               print the parser's tables (JSON)\n"
     "  hmpm --help | --version\n"
     "SPEC may be '-' for standard input.\n"
     "Exit codes: 0 success; 2 invalid spec (one '/json/pointer: message' line per problem\n"
@@ -104,7 +107,8 @@ int command_validate(const std::vector<std::string>& args) {
   if (const int rc = load(args[0], result); rc != kExitOk) return rc;
   std::cout << "valid: " << result.job->name << "\n";
   print_cost(result.job->cost);
-  for (const auto& w : result.job->warnings) std::cerr << "hmpm: warning: " << w.path << ": " << w.message << "\n";
+  for (const auto& w : result.job->warnings)
+    std::cerr << "hmpm: warning: " << w.path << ": " << w.message << "\n";
   return kExitOk;
 }
 
@@ -176,16 +180,7 @@ int command_run(const std::vector<std::string>& args) {
 }
 
 int command_spec_keys() {
-  std::cout << "{";
-  bool first = true;
-  for (const auto& entry : hmpm::api::spec_object_keys()) {
-    std::cout << (first ? "\n" : ",\n") << "  \"" << entry.location << "\": [";
-    for (std::size_t i = 0; i < entry.keys.size(); ++i)
-      std::cout << (i ? ", " : "") << '"' << entry.keys[i] << '"';
-    std::cout << "]";
-    first = false;
-  }
-  std::cout << "\n}\n";
+  std::cout << hmpm::api::spec_tables_json();
   return kExitOk;
 }
 

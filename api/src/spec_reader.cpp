@@ -2,7 +2,6 @@
 #include "spec_reader.hpp"
 
 #include <algorithm>
-#include <charconv>
 #include <cmath>
 
 namespace hmpm::api {
@@ -182,14 +181,6 @@ std::string Range::describe() const {
   if (has_lo) return std::string(lo_open ? "> " : ">= ") + format_number(lo);
   if (has_hi) return std::string(hi_open ? "< " : "<= ") + format_number(hi);
   return "finite";
-}
-
-std::string format_number(double v) {
-  if (std::isnan(v)) return "nan";
-  if (std::isinf(v)) return v > 0 ? "inf" : "-inf";
-  char buf[32];
-  const auto r = std::to_chars(buf, buf + sizeof buf, v);
-  return std::string(buf, r.ptr);
 }
 
 std::string format_count(double v) {

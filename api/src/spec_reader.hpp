@@ -18,6 +18,7 @@
 #include <nlohmann/json.hpp>
 
 #include "hmpm/api/job.hpp"
+#include "hmpm/format.hpp"
 
 namespace hmpm::api {
 
@@ -49,9 +50,7 @@ struct Range {
   std::string describe() const;  ///< "> 0", "in (0, 1)", ...
 };
 
-/// Number formatting for messages: shortest text that reads back the same.
-std::string format_number(double v);
-
+/// Numbers in messages: hmpm::format_number (shortest text that reads back the same).
 /// A count for messages: digits when integral and below 1e18 ("9000000").
 std::string format_count(double v);
 

@@ -1,11 +1,12 @@
 // writers.cpp — see writers.hpp.
 #include "writers.hpp"
 
-#include <charconv>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <stdexcept>
+
+#include "hmpm/format.hpp"
 
 namespace hmpm::api {
 
@@ -34,16 +35,6 @@ void AtomicFile::commit() {
     throw std::runtime_error("cannot rename " + tmp_.string() + " to " + path_.string() + ": " +
                              ec.message());
   committed_ = true;
-}
-
-void append_number(std::string& out, double v, bool json) {
-  if (!std::isfinite(v)) {
-    out += json ? "null" : (std::isnan(v) ? "nan" : (v > 0 ? "inf" : "-inf"));
-    return;
-  }
-  char buf[32];
-  const auto r = std::to_chars(buf, buf + sizeof buf, v);
-  out.append(buf, r.ptr);
 }
 
 namespace {
@@ -106,7 +97,7 @@ void write_summary(const fs::path& path, const std::string& job_name, const RunR
   };
   auto num = [](double v) {
     std::string s;
-    append_number(s, v, true);
+    append_json_number(s, v);
     return s;
   };
   field("status", json_string(status_name(run.status)));
@@ -150,7 +141,7 @@ void write_series_json(const fs::path& path, const Series& s) {
   std::string line = "{\"time\": [";
   for (std::size_t r = 0; r < s.time.size(); ++r) {
     if (r) line += ", ";
-    append_number(line, s.time[r], true);
+    append_json_number(line, s.time[r]);
   }
   line += "],\n \"particles\": [";
   out << line;
@@ -160,18 +151,16 @@ void write_series_json(const fs::path& path, const Series& s) {
     line += "\"index\": " + std::to_string(s.particles[p]) + ", \"initial_position\": [";
     for (int a = 0; a < s.dimension; ++a) {
       if (a) line += ", ";
-      append_number(line,
-                    p < s.initial_positions.size()
-                        ? s.initial_positions[p][static_cast<std::size_t>(a)]
-                        : std::nan(""),
-                    true);
+      append_json_number(line, p < s.initial_positions.size()
+                                   ? s.initial_positions[p][static_cast<std::size_t>(a)]
+                                   : std::nan(""));
     }
     line += "]";
     out << line;
     for (std::size_t f = 0; f < s.fields.size() && f < s.values.size(); ++f) {
       const int nc = field_components(s.fields[f], s.dimension);
       // Vectors and tensors are arrays of components, also with one component (1D).
-      const bool scalar = field_components(s.fields[f], 3) == 1;
+      const bool scalar = field_info(s.fields[f]).kind == FieldKind::scalar;
       line = ",\n   ";
       line += json_string(field_name(s.fields[f]));
       line += ": [";
@@ -180,7 +169,7 @@ void write_series_json(const fs::path& path, const Series& s) {
         if (!scalar) line += "[";
         for (int c = 0; c < nc; ++c) {
           if (c) line += ", ";
-          append_number(line, series_value(s, f, r, p, nc, c), true);
+          append_json_number(line, series_value(s, f, r, p, nc, c));
         }
         if (!scalar) line += "]";
         if (line.size() > (1u << 16)) {
@@ -207,9 +196,10 @@ void write_series_csv(const fs::path& path, const Series& s) {
       for (int c = 0; c < nc; ++c) {
         line += ",p" + std::to_string(s.particles[p]) + "_" + field_name(s.fields[f]);
         // Vectors always carry an axis suffix (also in 1D), scalars none.
-        if (nc == 6)
+        const FieldKind kind = field_info(s.fields[f]).kind;
+        if (kind == FieldKind::tensor)
           line += std::string("_") + kTensorSuffix[c];
-        else if (field_components(s.fields[f], 3) == 3)
+        else if (kind == FieldKind::vector)
           line += std::string("_") + kVectorSuffix[c];
       }
     }
@@ -217,13 +207,13 @@ void write_series_csv(const fs::path& path, const Series& s) {
   out << line << '\n';
   for (std::size_t r = 0; r < series_rows(s); ++r) {
     line.clear();
-    append_number(line, s.time[r], false);
+    append_number(line, s.time[r]);
     for (std::size_t p = 0; p < s.particles.size(); ++p)
       for (std::size_t f = 0; f < s.fields.size() && f < s.values.size(); ++f) {
         const int nc = field_components(s.fields[f], s.dimension);
         for (int c = 0; c < nc; ++c) {
           line += ',';
-          append_number(line, series_value(s, f, r, p, nc, c), false);
+          append_number(line, series_value(s, f, r, p, nc, c));
         }
       }
     out << line << '\n';
@@ -345,7 +335,7 @@ void write_snapshot_vtu(const fs::path& path, const Snapshot& s) {
          "      <DataArray type=\"Float64\" Name=\"TimeValue\" NumberOfTuples=\"1\" "
          "format=\"ascii\">";
   std::string t;
-  append_number(t, s.time, false);
+  append_number(t, s.time);
   out << t << "</DataArray>\n    </FieldData>\n";
   out << "    <Piece NumberOfPoints=\"" << n << "\" NumberOfCells=\"" << n
       << "\">\n      <PointData>\n";
@@ -385,7 +375,7 @@ void write_pvd(const fs::path& path, const std::vector<std::pair<double, std::st
          "  <Collection>\n";
   for (const auto& [time, name] : entries) {
     std::string t;
-    append_number(t, time, false);
+    append_number(t, time);
     out << "    <DataSet timestep=\"" << t << "\" group=\"\" part=\"0\" file=\"" << name
         << "\"/>\n";
   }

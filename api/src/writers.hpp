@@ -36,9 +36,6 @@ class AtomicFile {
   bool committed_ = false;
 };
 
-/// Appends the shortest round-trip text of `v` ("null" in JSON for non-finite).
-void append_number(std::string& out, double v, bool json);
-
 /// summary.json: status, message, steps, end_time, dt, particles, nodes,
 /// solve_seconds, particle_steps_per_second, plus warnings, name,
 /// hmpm_version, state_bytes, cost and the list of files.

@@ -15,39 +15,6 @@
 
 namespace hmpm {
 
-int field_components(Field f, int dim) {
-  switch (f) {
-    case Field::position:
-    case Field::displacement:
-    case Field::velocity:
-    case Field::darcy_velocity:
-      return dim;
-    case Field::effective_stress:
-    case Field::total_stress:
-    case Field::strain:
-      return 6;
-    case Field::pore_pressure:
-    case Field::porosity:
-      return 1;
-  }
-  return 1;
-}
-
-const char* field_name(Field f) {
-  switch (f) {
-    case Field::position: return "position";
-    case Field::displacement: return "displacement";
-    case Field::velocity: return "velocity";
-    case Field::pore_pressure: return "pore_pressure";
-    case Field::darcy_velocity: return "darcy_velocity";
-    case Field::effective_stress: return "effective_stress";
-    case Field::strain: return "strain";
-    case Field::porosity: return "porosity";
-    case Field::total_stress: return "total_stress";
-  }
-  return "?";
-}
-
 const char* status_name(RunStatus s) {
   switch (s) {
     case RunStatus::successful: return "successful";

@@ -5,8 +5,10 @@ per time, vectors as arrays of `dim` components, tensors as 6), series.csv
 (same numbers, one row per time), snapshots.pvd and every .vtu it lists
 (read with meshio: point count = summary particles, the expected fields).
 
-Usage: check_results.py DIR [--status S] [--particles N] [--snapshot-fields a,b]
-                            [--require-series] [--require-snapshots]
+Usage: check_results.py DIR --hmpm HMPM [--status S] [--particles N]
+                            [--snapshot-fields a,b] [--require-series] [--require-snapshots]
+The kind of each field (scalar, vector, tensor) comes from `HMPM spec-keys`,
+the solver's field table, not from a copy here.
 Exit 0 when everything holds, 1 with one line per problem otherwise.
 """
 import argparse
@@ -14,13 +16,12 @@ import csv
 import json
 import math
 import os
+import subprocess
 import sys
 import xml.etree.ElementTree as ET
 
 SUMMARY_KEYS = ["status", "message", "steps", "end_time", "dt", "particles", "nodes",
                 "solve_seconds", "particle_steps_per_second"]
-TENSORS = {"effective_stress", "total_stress", "strain"}
-SCALARS = {"pore_pressure", "porosity"}
 VECTOR_SUFFIX = ["x", "y", "z"]
 TENSOR_SUFFIX = ["xx", "yy", "zz", "xy", "yz", "zx"]
 
@@ -31,7 +32,14 @@ def same(a, b):
     return a == b or abs(a - b) <= 1e-12 * max(abs(a), abs(b))
 
 
-def check_series(d, problems):
+def field_kinds(hmpm):
+    """{field name: "scalar" | "vector" | "tensor"} from the built hmpm."""
+    tables = json.loads(subprocess.run([hmpm, "spec-keys"], check=True, capture_output=True,
+                                       text=True).stdout)
+    return {f["name"]: f["kind"] for f in tables["fields"]}
+
+
+def check_series(d, kinds, problems):
     with open(os.path.join(d, "series.json")) as f:
         series = json.load(f)
     times = series["time"]
@@ -50,14 +58,17 @@ def check_series(d, problems):
                 problems.append(f"series.json: {field} of particle {p['index']} has {len(values)} rows, "
                                 f"time has {len(times)}")
                 continue
-            if field in SCALARS:
+            if field not in kinds:
+                problems.append(f"series.json: '{field}' is not a field of the solver's table")
+                continue
+            if kinds[field] == "scalar":
                 names, width = [""], 1
-            elif field in TENSORS:
+            elif kinds[field] == "tensor":
                 names, width = ["_" + s for s in TENSOR_SUFFIX], 6
             else:
                 names, width = ["_" + s for s in VECTOR_SUFFIX[:dim]], dim
             expected_columns += [f"p{p['index']}_{field}{n}" for n in names]
-            scalar = field in SCALARS
+            scalar = kinds[field] == "scalar"
             for r, row in enumerate(values):
                 cells = [row] if scalar else row
                 if not scalar and (not isinstance(row, list) or len(row) != width):
@@ -108,6 +119,7 @@ def check_snapshots(d, particles, fields, problems):
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("dir")
+    ap.add_argument("--hmpm", required=True, help="the built hmpm (its spec-keys gives the field kinds)")
     ap.add_argument("--status")
     ap.add_argument("--particles", type=int)
     ap.add_argument("--snapshot-fields", default="")
@@ -125,7 +137,7 @@ def main():
                         f"expected {args.status!r}")
     particles = args.particles if args.particles is not None else summary.get("particles")
     if args.require_series or os.path.exists(os.path.join(args.dir, "series.json")):
-        check_series(args.dir, problems)
+        check_series(args.dir, field_kinds(args.hmpm), problems)
     snapshots = 0
     if args.require_snapshots or os.path.exists(os.path.join(args.dir, "snapshots.pvd")):
         fields = [f for f in args.snapshot_fields.split(",") if f]

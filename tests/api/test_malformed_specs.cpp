@@ -5,6 +5,7 @@
 //
 // Most cases are one mutation of tests/api/data/valid-2d.json: set the value
 // at a pointer (or remove it when `value` is null).
+#include <set>
 #include <string>
 #include <vector>
 
@@ -207,8 +208,22 @@ std::string listing(const ParseResult& r) {
   return s;
 }
 
-TEST(MalformedSpecs, AtLeastThirtyCases) {
-  EXPECT_GE(std::size(kMutations) + raw_cases().size(), 30u);
+// Each case must be the cause of the error it expects: the spec it mutates
+// is valid, its mutation changes that spec, and its name is its own.
+TEST(MalformedSpecs, EachCaseMutatesTheValidSpec) {
+  const std::string valid_text = read_text(source_path("tests/api/data/valid-2d.json"));
+  const ParseResult base = parse_job(valid_text);
+  EXPECT_TRUE(base.ok()) << listing(base);
+  const json valid = json::parse(valid_text);
+  std::set<std::string> names;
+  for (const Mutation& m : kMutations) {
+    EXPECT_TRUE(names.insert(m.name).second) << "two cases are named " << m.name;
+    EXPECT_NE(mutated(m), valid) << m.name << " does not change the valid spec";
+  }
+  for (const RawCase& c : raw_cases()) {
+    EXPECT_TRUE(names.insert(c.name).second) << "two cases are named " << c.name;
+    EXPECT_NE(c.text, valid_text) << c.name << " is the valid spec";
+  }
 }
 
 TEST(MalformedSpecs, ParseJobReportsTheExactPointer) {

@@ -214,6 +214,40 @@ TEST(ParseJob, CompressibleFluidIsAWarningNotAnError) {
   EXPECT_TRUE(warnings_of(spec).empty());
 }
 
+// A material's pointer is built from its name as one token: "a/b" is
+// "/materials/a~1b", never confused with a material "a" beside it (whose
+// name is a prefix of the other's followed by '/').
+TEST(ParseJob, SolverIssuesOfANestedMaterialNameGetItsOwnPointer) {
+  json spec = json::parse(read_text(source_path("examples/darcy-flow.json")));
+  json soil = spec["materials"]["soil"];
+  spec["materials"] = {{"a", soil}, {"a/b", soil}};
+  spec["materials"]["a/b"]["hydraulic"]["fluid_bulk_modulus"] = 1.5e6;
+  for (json& body : spec["bodies"]) body["material"] = "a/b";
+  const ParseResult r = parse_job(spec.dump());
+  for (const auto& e : r.errors) ADD_FAILURE() << e.path << ": " << e.message;
+  ASSERT_TRUE(r.job.has_value());
+  ASSERT_EQ(r.job->warnings.size(), 1u);
+  EXPECT_EQ(r.job->warnings[0].path, "/materials/a~1b/hydraulic");
+  // The same for an error found by the solver's checks (geostatic: one pore fluid).
+  json geo = json::parse(read_text(source_path("tests/api/data/valid-2d.json")));
+  geo["bodies"][0]["initial"].erase("pore_pressure");
+  geo["bodies"][0]["initial"].erase("effective_stress");
+  geo["initial_state"] = {{"geostatic", {{"water_table", 0.75}}}};
+  json sand = geo["materials"]["sand"];
+  geo["materials"] = {{"a", sand}, {"a/b", sand}};
+  geo["materials"]["a/b"]["hydraulic"]["fluid_density"] = 1100;
+  geo["bodies"][0]["material"] = "a";
+  geo["bodies"][1]["material"] = "a/b";
+  const ParseResult g = parse_job(geo.dump());
+  ASSERT_FALSE(g.errors.empty());
+  const bool found = std::any_of(g.errors.begin(), g.errors.end(), [](const SpecError& e) {
+    return e.path == "/materials/a~1b/hydraulic/fluid_density";
+  });
+  std::string all;
+  for (const auto& e : g.errors) all += "  " + e.path + ": " + e.message + "\n";
+  EXPECT_TRUE(found) << all;
+}
+
 TEST(ParseJob, BarVibrationMatchesTheContract) {
   const ParsedJob job = parse_valid(read_text(source_path("examples/bar-vibration.json")));
   EXPECT_EQ(job.cost.particles, 13);

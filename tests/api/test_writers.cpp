@@ -135,7 +135,7 @@ TEST(Writers, SnapshotsReadBackWithMeshio) {
   const auto r =
       testing::run_command("bash -c " + std::string("\"") + py + " '" +
                                testing::source_path("tests/api/check_results.py").string() + "' '" +
-                               dir.path().string() +
+                               dir.path().string() + "' --hmpm '" + HMPM_EXE +
                                "' --particles 7 --require-snapshots --snapshot-fields "
                                "velocity,pore_pressure,effective_stress\"",
                            fs::temp_directory_path());

@@ -20,6 +20,8 @@
 #include <variant>
 #include <vector>
 
+#include "hmpm/fields.hpp"
+
 namespace hmpm {
 
 /// A point or vector with up to three components; unused trailing components
@@ -184,25 +186,6 @@ struct TimeControl {
   std::optional<double> dt;   ///< s; absent: automatic
   double courant = 0.5;       ///< factor on the stable step when dt is automatic
 };
-
-enum class Field : std::uint8_t {
-  position,
-  displacement,
-  velocity,
-  pore_pressure,
-  darcy_velocity,
-  effective_stress,
-  strain,
-  porosity,
-  total_stress,
-};
-inline constexpr int field_count = 9;
-
-/// Number of components a field has in `dim` dimensions (vectors: dim;
-/// tensors: 6 in Voigt order xx, yy, zz, xy, yz, zx; scalars: 1).
-int field_components(Field f, int dim);
-/// The contract's name of a field ("pore_pressure", ...).
-const char* field_name(Field f);
 
 struct OutputRequest {
   std::vector<std::int64_t> series_particles;  ///< global particle indices

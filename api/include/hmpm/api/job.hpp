@@ -103,6 +103,13 @@ struct SpecObjectKeys {
 };
 const std::vector<SpecObjectKeys>& spec_object_keys();
 
+/// The parser's tables as JSON text (what `hmpm spec-keys` prints):
+/// {"objects": {location: [keys]}, "values": {location: [allowed values]},
+///  "fields": [{"name", "kind"}], "models": [{"name", "parameters": [{"key",
+///  "required", "default", "range": {JSON Schema bounds}}]}]}.
+/// The JSON Schema test compares the schema with it.
+std::string spec_tables_json();
+
 /// The hmpm version ("0.1.0"), as written into summary.json.
 const char* version();
 

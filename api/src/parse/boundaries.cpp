@@ -1,0 +1,101 @@
+// boundaries.cpp — the "boundaries" section: grid nodes with prescribed
+// velocity components, pore pressure, rigid ties and wall friction.
+#include <limits>
+
+#include "parser.hpp"
+
+namespace hmpm::api::parse {
+namespace {
+
+constexpr std::string_view kBoundary[] = {"nodes", "velocity", "pore_pressure", "rigid",
+                                          "friction"};
+constexpr std::string_view kBoundaryRequired[] = {"nodes"};
+
+void read_boundary(ParseContext& c, const json& j, const std::string& path) {
+  SpecReader& r = c.r;
+  if (!r.object(j, path, kBoundary, kBoundaryRequired)) return;
+  Boundary b;
+  if (j.contains("nodes")) {
+    bool all = false;
+    const std::string np = path + "/nodes";
+    if (auto box = read_selection(c, j["nodes"], np, all)) {
+      b.nodes.all = all;
+      b.nodes.box = *box;
+      if (!all && c.grid_ok) {
+        double count = 1;
+        for (int a = 0; a < c.dim; ++a)
+          count *= static_cast<double>(nodes_inside(c.p.grid, a, box->min[a], box->max[a]));
+        if (count == 0)
+          r.error(np + "/box", "selects no grid node; nodes lie at min + i * cell size");
+      }
+    }
+  }
+  if (!j.contains("velocity") && !j.contains("pore_pressure") && !j.contains("rigid"))
+    r.error(path, "needs 'velocity', 'pore_pressure' and/or 'rigid'");
+  if (j.contains("velocity")) {
+    const json& v = j["velocity"];
+    const std::string vp = path + "/velocity";
+    if (r.per_axis(v, vp, c.dim, "number, formula in t or null")) {
+      for (std::size_t a = 0; a < v.size() && a < 3; ++a) {
+        if (v[a].is_null()) continue;
+        if (auto f = read_value_of_time(c, v[a], child_pointer(vp, a))) {
+          b.velocity[a] = std::move(*f);
+          b.has_velocity = true;
+        }
+      }
+    }
+  }
+  if (j.contains("rigid")) {
+    const json& v = j["rigid"];
+    const std::string vp = path + "/rigid";
+    if (r.per_axis(v, vp, c.dim, "true or false")) {
+      for (std::size_t a = 0; a < v.size() && a < 3; ++a) {
+        const std::string ap = child_pointer(vp, a);
+        const auto tied = r.boolean(v[a], ap);
+        if (!tied) continue;
+        b.rigid[a] = *tied;
+        if (b.rigid[a] && b.velocity[a])
+          r.error(ap, "is true but velocity/" + std::to_string(a) +
+                          " prescribes that component; a rigid tie needs it free");
+      }
+    }
+  }
+  if (j.contains("friction")) {
+    // A Coulomb coefficient, or "rough" for no slip; which component is the
+    // wall normal (exactly one prescribed) is checked by check_problem.
+    const json& f = j["friction"];
+    const std::string fp = path + "/friction";
+    if (f.is_string()) {
+      if (f.get<std::string>() == "rough")
+        b.friction = std::numeric_limits<double>::infinity();
+      else
+        r.error(fp, "expected a number >= 0 (Coulomb coefficient) or \"rough\" (no slip), got \"" +
+                        f.get<std::string>() + "\"");
+    } else if (auto mu = r.number(f, fp, Range::non_negative())) {
+      b.friction = *mu;
+    }
+    if (!j.contains("velocity"))
+      r.error(fp, "needs 'velocity' with the wall-normal component prescribed and the others null");
+  }
+  if (j.contains("pore_pressure")) {
+    b.pore_pressure = read_value_of_time(c, j["pore_pressure"], path + "/pore_pressure");
+    if (!c.any_pore_pressure_bc) c.first_pore_pressure_bc = path + "/pore_pressure";
+    c.any_pore_pressure_bc = true;
+  }
+  c.p.boundaries.push_back(std::move(b));
+}
+
+}  // namespace
+
+void boundary_keys(std::vector<SpecObjectKeys>& out) {
+  out.push_back(keys_entry("/boundaries/*", kBoundary));
+  out.push_back(keys_entry("/boundaries/*/nodes", selection_key_names()));
+  out.push_back(keys_entry("/boundaries/*/nodes/box", box_key_names()));
+}
+
+void read_boundaries(ParseContext& c, const json& j, const std::string& path) {
+  if (!c.r.array(j, path)) return;
+  for (std::size_t i = 0; i < j.size(); ++i) read_boundary(c, j[i], child_pointer(path, i));
+}
+
+}  // namespace hmpm::api::parse

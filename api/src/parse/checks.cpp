@@ -1,0 +1,209 @@
+// checks.cpp — the checks that need the whole Problem, run once every
+// section has been read without error: the particle budget (before anything
+// allocates per particle), "near" selections, the solver's check_problem,
+// traction selections, formulas finite where they are evaluated, and the
+// limits of a shared server from the cost estimate.
+#include <algorithm>
+#include <cmath>
+
+#include "parser.hpp"
+
+namespace hmpm::api::parse {
+namespace {
+
+// Work bound for laying out bodies (bodies x cells summed over the axes).
+constexpr double kMaxLayoutWork = 5e7;
+// Work bound for checks that visit every particle per selection.
+constexpr double kMaxNearWork = 2e8;
+
+bool check_particle_budget(ParseContext& c) {
+  // Count particles from the layout rule without generating them, so a huge
+  // body is refused before anything allocates per particle.
+  // Laying out a body walks every cell along each axis; many bodies on a
+  // fine grid would make validation itself slow.
+  const Problem& p = c.p;
+  double axis_cells = 0;
+  for (int a = 0; a < c.dim; ++a) axis_cells += p.grid.cells[a];
+  const double layout_work = axis_cells * static_cast<double>(p.bodies.size());
+  if (layout_work > kMaxLayoutWork) {
+    c.r.error("/bodies", std::to_string(p.bodies.size()) + " bodies on a grid of " +
+                             format_count(axis_cells) +
+                             " cells summed over the axes is too much work to lay out (" +
+                             format_count(layout_work) + " > " + format_count(kMaxLayoutWork) +
+                             "); merge bodies");
+    return false;
+  }
+  double total = 0;
+  for (std::size_t b = 0; b < p.bodies.size(); ++b) {
+    const Body& body = p.bodies[b];
+    double n = 1;
+    for (int a = 0; a < c.dim; ++a) {
+      const double along =
+          static_cast<double>(cells_inside(p.grid, a, body.box.min[a], body.box.max[a])) *
+          body.particles_per_cell;
+      if (along > static_cast<double>(c.limits.max_particles)) {
+        c.r.error(child_pointer("/bodies", b) + "/particles_per_cell",
+                  "body would have " + format_count(along) + " particles along " +
+                      std::string(kAxisNames[a]) + "; the limit is " +
+                      std::to_string(c.limits.max_particles) + " particles in all");
+        return false;
+      }
+      n *= along;
+    }
+    total += n;
+  }
+  if (total > static_cast<double>(c.limits.max_particles)) {
+    c.r.error("/bodies", "the bodies would create " + format_count(total) +
+                             " particles; the limit is " + std::to_string(c.limits.max_particles));
+    return false;
+  }
+  return true;
+}
+
+void resolve_near(ParseContext& c) {
+  if (c.near.empty()) return;
+  const std::int64_t n = count_particles(c.p);
+  if (static_cast<double>(c.near.size()) * static_cast<double>(n) > kMaxNearWork) {
+    c.r.error("/output/series/particles",
+              std::to_string(c.near.size()) + " 'near' selections over " + std::to_string(n) +
+                  " particles is too much work to resolve; name particles by index instead");
+    return;
+  }
+  for (const PendingNear& s : c.near) {
+    const std::int64_t i = nearest_particle(c.p, s.at);
+    if (i < 0)
+      c.r.error(s.path, "no particle exists");
+    else
+      c.p.output.series_particles[s.slot] = i;
+  }
+}
+
+void check_traction_selections(ParseContext& c) {
+  // A convenience check, skipped when it would cost more than a moment.
+  const Problem& p = c.p;
+  if (p.tractions.empty() ||
+      static_cast<double>(p.tractions.size()) * static_cast<double>(count_particles(p)) >
+          kMaxNearWork)
+    return;
+  const std::vector<Vec3> positions = initial_positions(p);
+  for (std::size_t k = 0; k < p.tractions.size(); ++k) {
+    const Box& box = p.tractions[k].particles;
+    const bool any = std::any_of(positions.begin(), positions.end(), [&](const Vec3& x) {
+      for (int a = 0; a < c.dim; ++a)
+        if (x[a] < box.min[a] - 1e-12 || x[a] > box.max[a] + 1e-12)
+          return false;  // as the solver selects
+      return true;
+    });
+    if (!any)
+      c.r.error(c.traction_paths[k],
+                "selects no particle; particles sit at sub-cell centres, e.g. the "
+                "top row of a body is half a particle spacing below its top face");
+  }
+}
+
+void check_time_formulas(ParseContext& c) {
+  // At up to 1001 instants over [0, end], about a million evaluations in all.
+  const int intervals = static_cast<int>(std::clamp(
+      1e6 / static_cast<double>(std::max<std::size_t>(c.time_formulas.size(), 1)), 1.0, 1000.0));
+  for (const TimeFormula& tf : c.time_formulas) {
+    for (int k = 0; k <= intervals; ++k) {
+      const double t = c.p.time.end * k / intervals;
+      const double v = tf.f(t);
+      if (!std::isfinite(v)) {
+        c.r.error(tf.path,
+                  "the formula gives " + format_number(v) + " at t = " + format_number(t) + " s");
+        break;
+      }
+      if (c.damping_formula && tf.path == "/local_damping" && !(v >= 0.0 && v < 1.0)) {
+        c.r.error(tf.path, "the formula gives " + format_number(v) + " at t = " + format_number(t) +
+                               " s; local damping must lie in [0, 1)");
+        break;
+      }
+    }
+  }
+}
+
+void check_position_formulas(ParseContext& c) {
+  // At every particle of the body, or a regular sample of about a million
+  // evaluations in all when the bodies are large.
+  if (c.position_formulas.empty()) return;
+  const Problem& p = c.p;
+  std::vector<std::vector<Vec3>> positions(p.bodies.size());
+  double evaluations = 0;
+  for (const PositionFormula& pf : c.position_formulas) {
+    if (pf.body >= p.bodies.size()) continue;
+    if (positions[pf.body].empty()) {
+      Problem one;
+      one.dimension = p.dimension;
+      one.grid = p.grid;
+      Body b;
+      b.box = p.bodies[pf.body].box;
+      b.particles_per_cell = p.bodies[pf.body].particles_per_cell;
+      one.bodies.push_back(b);
+      positions[pf.body] = initial_positions(one);
+    }
+    evaluations += static_cast<double>(positions[pf.body].size());
+  }
+  const std::size_t stride = static_cast<std::size_t>(std::max(1.0, std::ceil(evaluations / 1e6)));
+  for (const PositionFormula& pf : c.position_formulas) {
+    if (pf.body >= p.bodies.size()) continue;
+    const std::vector<Vec3>& xs = positions[pf.body];
+    for (std::size_t i = 0; i < xs.size(); i += stride) {
+      const double v = pf.f(xs[i]);
+      if (!std::isfinite(v)) {
+        std::string at = "x = " + format_number(xs[i][0]);
+        if (c.dim > 1) at += ", y = " + format_number(xs[i][1]);
+        if (c.dim > 2) at += ", z = " + format_number(xs[i][2]);
+        c.r.error(pf.path, "the formula gives " + format_number(v) + " at a particle of body " +
+                               std::to_string(pf.body) + " (" + at + ")");
+        break;
+      }
+    }
+  }
+}
+
+void check_limits(ParseContext& c) {
+  const Problem& p = c.p;
+  const Limits& limits = c.limits;
+  const CostEstimate cost = estimate_cost(p);
+  const StableStep s = stable_step(p);
+  const double steps = std::ceil(p.time.end / s.chosen - 1e-9);
+  if (steps > static_cast<double>(limits.max_steps)) {
+    const std::string why =
+        p.time.dt ? "end " + format_number(p.time.end) + " s / dt " + format_number(s.chosen) + " s"
+                  : "end " + format_number(p.time.end) + " s / automatic dt " +
+                        format_number(s.chosen) + " s";
+    c.r.error(p.time.dt ? "/time/dt" : "/time/end", "the run needs " + format_count(steps) +
+                                                        " time steps (" + why + "); the limit is " +
+                                                        std::to_string(limits.max_steps));
+  }
+  if (cost.series_rows > limits.max_series_rows)
+    c.r.error("/output/series/interval",
+              "the series would have " + std::to_string(cost.series_rows) + " rows; the limit is " +
+                  std::to_string(limits.max_series_rows) + "; use a larger interval");
+  if (cost.snapshots > limits.max_snapshots)
+    c.r.error("/output/snapshots/interval",
+              "the run would write " + std::to_string(cost.snapshots) +
+                  " snapshots; the limit is " + std::to_string(limits.max_snapshots) +
+                  "; use a larger interval");
+  if (cost.output_bytes > limits.max_output_bytes)
+    c.r.error("/output", "the result files would take about " + std::to_string(cost.output_bytes) +
+                             " bytes; the limit is " + std::to_string(limits.max_output_bytes));
+}
+
+}  // namespace
+
+void check_whole_problem(ParseContext& c) {
+  if (!check_particle_budget(c)) return;
+  resolve_near(c);
+  for (const ProblemIssue& issue : check_problem(c.p))
+    c.r.error(pointer_of_solver_location(c.p, issue.where), issue.message);
+  if (c.r.error_count() > 0) return;
+  check_traction_selections(c);
+  check_time_formulas(c);
+  check_position_formulas(c);
+  if (c.r.error_count() > 0) return;
+  check_limits(c);
+}
+
+}  // namespace hmpm::api::parse

@@ -1,0 +1,124 @@
+// job.cpp — parse_job: the top level of a job spec and the one pass over it.
+//
+// Reads the document's top-level keys (the table below) and hands each
+// section to its reader; when the document has no error, runs the
+// whole-problem checks, then builds the ParsedJob with its cost estimate
+// and the solver's warnings. Nothing after parse_job looks anything up by
+// string.
+#include <algorithm>
+
+#include "parser.hpp"
+
+namespace hmpm::api {
+namespace parse {
+namespace {
+
+constexpr std::string_view kTop[] = {
+    "name",          "description",      "dimension",    "grid",      "shape_function", "materials",
+    "bodies",        "gravity",          "boundaries",   "tractions", "time",           "output",
+    "local_damping", "gravity_constant", "initial_state"};
+constexpr std::string_view kTopRequired[] = {"dimension", "grid", "materials", "bodies", "time"};
+// At most this many errors are reported (then one line counting the rest).
+constexpr std::size_t kMaxErrors = 1000;
+
+void read_root(ParseContext& c, const json& root) {
+  SpecReader& r = c.r;
+  if (!r.object(root, "", kTop, kTopRequired)) return;
+  if (root.contains("name"))
+    if (auto s = r.string(root["name"], "/name", 200)) c.name = *s;
+  if (root.contains("description")) r.string(root["description"], "/description", 100'000);
+  if (root.contains("dimension"))
+    if (auto d = r.integer(root["dimension"], "/dimension", 1, 3)) c.dim = static_cast<int>(*d);
+  c.p.dimension = std::max(c.dim, 1);
+  if (root.contains("grid")) read_grid(c, root["grid"], "/grid");
+  if (root.contains("shape_function"))
+    read_shape_function(c, root["shape_function"], "/shape_function");
+  if (root.contains("materials")) read_materials(c, root["materials"], "/materials");
+  if (root.contains("bodies")) read_bodies(c, root["bodies"], "/bodies");
+  if (root.contains("gravity"))
+    if (auto g = r.vector(root["gravity"], "/gravity", c.dim)) c.p.gravity = *g;
+  if (root.contains("gravity_constant"))
+    if (auto g = r.number(root["gravity_constant"], "/gravity_constant", Range::positive()))
+      c.p.gravity_constant = *g;
+  if (root.contains("local_damping"))
+    read_local_damping(c, root["local_damping"], "/local_damping");
+  if (root.contains("boundaries")) read_boundaries(c, root["boundaries"], "/boundaries");
+  if (root.contains("tractions")) read_tractions(c, root["tractions"], "/tractions");
+  if (root.contains("time")) read_time(c, root["time"], "/time");
+  if (root.contains("initial_state"))
+    read_initial_state(c, root["initial_state"], "/initial_state");
+  if (root.contains("output")) read_output(c, root["output"], "/output");
+
+  if (c.any_pore_pressure_bc &&
+      std::none_of(c.p.materials.begin(), c.p.materials.end(),
+                   [](const Material& m) { return m.hydraulic.has_value(); }))
+    r.error(c.first_pore_pressure_bc, "prescribes pore pressure but no material has 'hydraulic'");
+}
+
+ParseResult parse_text(std::string_view text, const Limits& limits) {
+  ParseResult result;
+  if (text.size() > static_cast<std::size_t>(limits.max_body_bytes)) {
+    result.errors.push_back({"", "spec is " + std::to_string(text.size()) +
+                                     " bytes; the limit is " +
+                                     std::to_string(limits.max_body_bytes) + " bytes"});
+    return result;
+  }
+  json root;
+  if (!parse_json_guarded(text, limits.max_json_depth, root, result.errors)) return result;
+  ParseContext c(limits);
+  read_root(c, root);
+  if (c.r.error_count() == 0) check_whole_problem(c);
+  result.errors = std::move(c.r.errors());
+  // A hostile spec can hold millions of mistakes; the first thousand say enough.
+  if (result.errors.size() > kMaxErrors) {
+    const std::size_t more = result.errors.size() - kMaxErrors;
+    result.errors.resize(kMaxErrors);
+    result.errors.push_back({"", std::to_string(more) + " more errors not shown"});
+  }
+  if (result.errors.empty()) {
+    ParsedJob job;
+    job.name = c.name;
+    job.cost = estimate_cost(c.p);
+    for (const ProblemIssue& w : problem_warnings(c.p))
+      job.warnings.push_back({pointer_of_solver_location(c.p, w.where), w.message});
+    job.problem = std::move(c.p);
+    result.job = std::move(job);
+  }
+  return result;
+}
+
+}  // namespace
+
+SpecObjectKeys keys_entry(std::string location, Keys keys) {
+  return SpecObjectKeys{std::move(location), std::vector<std::string>(keys.begin(), keys.end())};
+}
+
+}  // namespace parse
+
+const std::vector<SpecObjectKeys>& spec_object_keys() {
+  static const std::vector<SpecObjectKeys> table = [] {
+    std::vector<SpecObjectKeys> t{parse::keys_entry("", parse::kTop)};
+    parse::grid_keys(t);
+    parse::material_keys(t);
+    parse::body_keys(t);
+    parse::boundary_keys(t);
+    parse::traction_keys(t);
+    parse::initial_state_keys(t);
+    parse::time_keys(t);
+    parse::output_keys(t);
+    return t;
+  }();
+  return table;
+}
+
+ParseResult parse_job(std::string_view json_text, const Limits& limits) {
+  try {
+    return parse::parse_text(json_text, limits);
+  } catch (const std::exception& e) {
+    ParseResult r;
+    r.errors.push_back({"", std::string("internal error while reading the spec: ") + e.what()});
+    return r;
+  }
+}
+
+}  // namespace hmpm::api

@@ -1,0 +1,139 @@
+// materials.cpp — the "materials" section: named materials, their elastic
+// constants, their constitutive model (parameters from material_models.cpp)
+// and their optional hydraulic properties.
+#include <algorithm>
+
+#include "material_models.hpp"
+#include "parser.hpp"
+
+namespace hmpm::api::parse {
+namespace {
+
+// Keys every material reads; the model's parameters and "hydraulic" follow.
+constexpr std::string_view kMaterialCommon[] = {"model", "density", "youngs_modulus",
+                                                "poisson_ratio"};
+constexpr std::string_view kMaterialRequired[] = {"model", "density", "youngs_modulus",
+                                                  "poisson_ratio"};
+constexpr std::string_view kHydraulic[] = {"porosity",           "hydraulic_conductivity",
+                                           "fluid_bulk_modulus", "fluid_density",
+                                           "solid_bulk_modulus", "darcy_inertia"};
+constexpr std::string_view kHydraulicRequired[] = {"porosity", "hydraulic_conductivity",
+                                                   "fluid_bulk_modulus"};
+
+// The keys a material accepts: the common ones, every model's parameters, "hydraulic".
+Keys material_key_names() {
+  static const std::vector<std::string_view> keys = [] {
+    std::vector<std::string_view> out(std::begin(kMaterialCommon), std::end(kMaterialCommon));
+    for (std::string_view k : model_parameter_keys()) out.push_back(k);
+    out.push_back("hydraulic");
+    return out;
+  }();
+  return keys;
+}
+
+// The model's parameters: keys of other models refused, required ones
+// present, each read in table order and checked against those before it.
+Plasticity read_model(SpecReader& r, const MaterialModel& model, const json& j,
+                      const std::string& path) {
+  const auto reads = [&](std::string_view key) {
+    return std::any_of(model.parameters.begin(), model.parameters.end(),
+                       [&](const ModelParameter& p) { return p.key == key; });
+  };
+  for (std::string_view key : model_parameter_keys())
+    if (!reads(key) && j.contains(key))
+      r.error(child_pointer(path, key),
+              "applies only to " + models_reading(key) + ", not '" + std::string(model.name) + "'");
+  for (const ModelParameter& p : model.parameters)
+    if (p.required && !j.contains(p.key))
+      r.error(child_pointer(path, p.key),
+              "is required for model '" + std::string(model.name) + "'");
+  std::vector<double> values;
+  for (const ModelParameter& p : model.parameters) {
+    values.push_back(p.fallback);
+    if (!j.contains(p.key)) continue;
+    const std::string pp = child_pointer(path, p.key);
+    if (auto v = r.number(j[std::string(p.key)], pp, p.range)) {
+      values.back() = *v;
+      if (p.check)
+        if (std::string why = p.check(*v, std::span(values).first(values.size() - 1)); !why.empty())
+          r.error(pp, std::move(why));
+    }
+  }
+  return model.build(values);
+}
+
+void read_hydraulic(SpecReader& r, Material& m, const json& j, const std::string& path) {
+  if (!r.object(j, path, kHydraulic, kHydraulicRequired)) return;
+  Hydraulic h;
+  r.number_at(j, path, "porosity", {0.0, 1.0, true, true}, h.porosity);
+  if (j.contains("hydraulic_conductivity"))
+    if (auto v = r.number(j["hydraulic_conductivity"], path + "/hydraulic_conductivity",
+                          Range::non_negative()))
+      h.hydraulic_conductivity = *v;
+  r.number_at(j, path, "fluid_bulk_modulus", Range::positive(), h.fluid_bulk_modulus);
+  r.number_at(j, path, "fluid_density", Range::positive(), h.fluid_density);
+  r.number_at(j, path, "solid_bulk_modulus", Range::positive(), h.solid_bulk_modulus);
+  if (j.contains("darcy_inertia"))
+    if (auto v = r.boolean(j["darcy_inertia"], path + "/darcy_inertia")) h.darcy_inertia = *v;
+  m.hydraulic = h;
+}
+
+void read_material(ParseContext& c, const std::string& name, const json& j,
+                   const std::string& path) {
+  SpecReader& r = c.r;
+  Material m;
+  m.name = name;
+  if (name.empty() || name.size() > 100)
+    r.error(path, "material names must have 1 to 100 characters");
+  if (r.object(j, path, material_key_names(), kMaterialRequired)) {
+    r.number_at(j, path, "density", Range::positive(), m.density);
+    r.number_at(j, path, "youngs_modulus", Range::positive(), m.youngs_modulus);
+    if (j.contains("poisson_ratio")) {
+      const json& v = j["poisson_ratio"];
+      const std::string vp = path + "/poisson_ratio";
+      if (v.is_number() && v.get<double>() == 0.5)
+        r.error(vp,
+                "is 0.5; must be in (-1, 0.5): an incompressible skeleton has an infinite "
+                "wave speed, so no explicit time step is stable");
+      else if (auto nu = r.number(v, vp, {-1.0, 0.5, true, true}))
+        m.poisson_ratio = *nu;
+    }
+    const MaterialModel* model = &material_models().front();
+    if (j.contains("model"))
+      if (auto s = r.one_of(j["model"], path + "/model", material_model_names()))
+        model = find_material_model(*s);
+    m.plasticity = read_model(r, *model, j, path);
+    if (j.contains("hydraulic")) read_hydraulic(r, m, j["hydraulic"], path + "/hydraulic");
+  }
+  c.material_index[name] = static_cast<int>(c.p.materials.size());
+  c.p.materials.push_back(std::move(m));
+}
+
+}  // namespace
+
+void material_keys(std::vector<SpecObjectKeys>& out) {
+  out.push_back(keys_entry("/materials/*", material_key_names()));
+  out.push_back(keys_entry("/materials/*/hydraulic", kHydraulic));
+}
+
+bool is_material_key_path(std::string_view relative) {
+  const std::size_t slash = relative.find('/');
+  const std::string_view head = relative.substr(0, slash);
+  const Keys keys = material_key_names();
+  if (std::find(keys.begin(), keys.end(), head) == keys.end()) return false;
+  if (slash == std::string_view::npos) return true;
+  return head == "hydraulic" && std::find(std::begin(kHydraulic), std::end(kHydraulic),
+                                          relative.substr(slash + 1)) != std::end(kHydraulic);
+}
+
+void read_materials(ParseContext& c, const json& j, const std::string& path) {
+  if (!j.is_object()) {
+    c.r.error(path, std::string("expected an object of named materials, got ") + j.type_name());
+    return;
+  }
+  if (j.empty()) c.r.error(path, "is empty; at least one material is needed");
+  for (const auto& [name, value] : j.items())
+    read_material(c, name, value, child_pointer(path, name));
+}
+
+}  // namespace hmpm::api::parse

@@ -1,0 +1,113 @@
+// output.cpp — the "output" section: the time series of chosen particles and
+// the snapshots, with their fields (names from hmpm::field_table).
+#include <algorithm>
+#include <limits>
+
+#include "parser.hpp"
+
+namespace hmpm::api::parse {
+namespace {
+
+constexpr std::string_view kOutput[] = {"series", "snapshots"};
+constexpr std::string_view kSeries[] = {"particles", "fields", "interval"};
+constexpr std::string_view kSeriesRequired[] = {"particles", "fields"};
+constexpr std::string_view kNear[] = {"near"};
+constexpr std::string_view kSnapshots[] = {"interval", "fields"};
+constexpr std::string_view kSnapshotsRequired[] = {"interval"};
+
+std::vector<Field> read_fields(SpecReader& r, const json& j, const std::string& path) {
+  std::vector<Field> out;
+  if (!r.array(j, path, 1)) return out;
+  for (std::size_t i = 0; i < j.size(); ++i) {
+    const std::string fp = child_pointer(path, i);
+    auto name = r.one_of(j[i], fp, field_names());
+    if (!name) continue;
+    const Field f = std::find_if(field_table.begin(), field_table.end(), [&](const FieldInfo& e) {
+                      return e.name == *name;
+                    })->field;
+    if (std::find(out.begin(), out.end(), f) != out.end()) {
+      r.error(fp, "'" + *name + "' is listed twice");
+      continue;
+    }
+    out.push_back(f);
+  }
+  return out;
+}
+
+void read_series_particles(ParseContext& c, const json& parts, const std::string& pp) {
+  SpecReader& r = c.r;
+  OutputRequest& out = c.p.output;
+  if (!r.array(parts, pp, 1)) return;
+  if (parts.size() > static_cast<std::size_t>(c.limits.max_series_particles)) {
+    r.error(pp, "selects " + std::to_string(parts.size()) + " particles; the limit is " +
+                    std::to_string(c.limits.max_series_particles));
+    return;
+  }
+  for (std::size_t i = 0; i < parts.size(); ++i) {
+    const std::string ip = child_pointer(pp, i);
+    const json& e = parts[i];
+    out.series_particles.push_back(-1);
+    if (e.is_object()) {
+      if (r.object(e, ip, kNear, kNear) && e.contains("near"))
+        if (auto at = r.vector(e["near"], ip + "/near", c.dim))
+          c.near.push_back({out.series_particles.size() - 1, *at, ip});
+    } else if (e.is_number()) {
+      if (auto n = r.integer(e, ip, 0, std::numeric_limits<std::int64_t>::max()))
+        out.series_particles.back() = *n;
+    } else {
+      r.error(ip, std::string(
+                      "expected a particle index (integer >= 0) or {\"near\": [x, ...]}, got ") +
+                      e.type_name());
+    }
+  }
+}
+
+}  // namespace
+
+Keys field_names() {
+  static const std::vector<std::string_view> names = [] {
+    std::vector<std::string_view> out;
+    for (const FieldInfo& f : field_table) out.push_back(f.name);
+    return out;
+  }();
+  return names;
+}
+
+void output_keys(std::vector<SpecObjectKeys>& out) {
+  out.push_back(keys_entry("/output", kOutput));
+  out.push_back(keys_entry("/output/series", kSeries));
+  out.push_back(keys_entry("/output/series/particles/*", kNear));
+  out.push_back(keys_entry("/output/snapshots", kSnapshots));
+}
+
+void read_output(ParseContext& c, const json& j, const std::string& path) {
+  SpecReader& r = c.r;
+  if (!r.object(j, path, kOutput)) return;
+  OutputRequest& out = c.p.output;
+  if (j.contains("series")) {
+    const json& s = j["series"];
+    const std::string sp = path + "/series";
+    if (r.object(s, sp, kSeries, kSeriesRequired)) {
+      if (s.contains("particles")) read_series_particles(c, s["particles"], sp + "/particles");
+      if (s.contains("fields")) out.series_fields = read_fields(r, s["fields"], sp + "/fields");
+      r.number_at(s, sp, "interval", Range::non_negative(), out.series_interval);
+    }
+  }
+  if (j.contains("snapshots")) {
+    const json& s = j["snapshots"];
+    const std::string sp = path + "/snapshots";
+    if (r.object(s, sp, kSnapshots, kSnapshotsRequired)) {
+      r.number_at(s, sp, "interval", Range::positive(), out.snapshot_interval);
+      if (s.contains("fields")) {
+        out.snapshot_fields = read_fields(r, s["fields"], sp + "/fields");
+        // Points of the VTU files are the particle positions: always written.
+        if (!out.snapshot_fields.empty() &&
+            std::find(out.snapshot_fields.begin(), out.snapshot_fields.end(), Field::position) ==
+                out.snapshot_fields.end())
+          out.snapshot_fields.insert(out.snapshot_fields.begin(), Field::position);
+      }
+    }
+  }
+}
+
+}  // namespace hmpm::api::parse

@@ -1,0 +1,139 @@
+// parser.hpp — what the section readers of a job spec share.
+//
+// parse_job walks the document once (job.cpp). Each spec section has its
+// own file in this folder with its accepted keys beside the code that reads
+// them: grid.cpp, materials.cpp (with material_models.cpp, the table of
+// constitutive models), bodies.cpp, boundaries.cpp, tractions.cpp,
+// initial_state.cpp, time.cpp, output.cpp; values.cpp reads what several
+// sections share (boxes, selections, formulas). Every reader records its
+// problems in the ParseContext's SpecReader with their JSON pointers and
+// fills the Problem as it goes. checks.cpp then runs the checks that need
+// the whole Problem, locations.cpp turns the solver's issue locations into
+// JSON pointers, and tables.cpp prints every table for `hmpm spec-keys`.
+#pragma once
+
+#include <map>
+#include <optional>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "hmpm/api/job.hpp"
+#include "spec_reader.hpp"
+
+namespace hmpm::api::parse {
+
+using Keys = std::span<const std::string_view>;
+
+inline constexpr std::string_view kAxisNames[] = {"x", "y", "z"};
+
+/// A formula (not a plain number) of position read from the spec, checked
+/// for finite values once the particles are known.
+struct PositionFormula {
+  std::size_t body;
+  std::string path;
+  FieldOfPosition f;
+};
+/// A formula of time read from the spec, checked over [0, end].
+struct TimeFormula {
+  std::string path;
+  FieldOfTime f;
+};
+/// An output.series particle given as {"near": [...]}, resolved once the
+/// particles are known.
+struct PendingNear {
+  std::size_t slot;  ///< index into series_particles
+  Vec3 at;
+  std::string path;
+};
+
+/// The state of one parse: the reader with its errors, the Problem being
+/// built and what the whole-problem checks need later.
+struct ParseContext {
+  explicit ParseContext(const Limits& l) : limits(l) {}
+
+  const Limits& limits;
+  SpecReader r;
+  Problem p;
+  std::string name = "job";
+  int dim = 0;           ///< 0 while unknown or invalid: vector lengths are not checked
+  bool grid_ok = false;  ///< grid valid: boxes can be checked against it
+  std::map<std::string, int> material_index;
+  std::vector<PendingNear> near;
+  std::vector<PositionFormula> position_formulas;
+  std::vector<TimeFormula> time_formulas;
+  bool damping_formula = false;  ///< local_damping given as a formula of t
+  std::vector<std::string> traction_paths;
+  bool any_pore_pressure_bc = false;
+  std::string first_pore_pressure_bc;
+};
+
+// ------------------------------------------------------------- sections
+// Each reads the value `j` found at JSON pointer `path`.
+void read_grid(ParseContext& c, const json& j, const std::string& path);
+void read_shape_function(ParseContext& c, const json& j, const std::string& path);
+void read_materials(ParseContext& c, const json& j, const std::string& path);
+void read_bodies(ParseContext& c, const json& j, const std::string& path);
+void read_boundaries(ParseContext& c, const json& j, const std::string& path);
+void read_tractions(ParseContext& c, const json& j, const std::string& path);
+void read_time(ParseContext& c, const json& j, const std::string& path);
+void read_local_damping(ParseContext& c, const json& j, const std::string& path);
+void read_initial_state(ParseContext& c, const json& j, const std::string& path);
+void read_output(ParseContext& c, const json& j, const std::string& path);
+
+// ------------------------------------------------------ shared value readers
+/// {"min": [...], "max": [...]} inside the grid (when the grid is valid).
+std::optional<Box> read_box(ParseContext& c, const json& j, const std::string& path);
+/// {"box": {...}} or "all"; "all" is the whole grid.
+std::optional<Box> read_selection(ParseContext& c, const json& j, const std::string& path,
+                                  bool& all);
+/// The keys of a box and of a selection object (for the key tables).
+Keys box_key_names();
+Keys selection_key_names();
+/// A number or a formula in x, y, z (recorded for the finiteness check).
+FieldOfPosition read_value_of_position(ParseContext& c, const json& j, const std::string& path);
+/// A number or a formula in t (recorded for the finiteness check).
+std::optional<FieldOfTime> read_value_of_time(ParseContext& c, const json& j,
+                                              const std::string& path);
+
+// ------------------------------------------------------ whole-problem checks
+/// Particle budget, "near" selections, the solver's check_problem,
+/// traction selections, finite formulas and the limits (checks.cpp).
+void check_whole_problem(ParseContext& c);
+
+/// The JSON pointer of a location the solver reports in the job-spec
+/// vocabulary ("time/dt", "materials/NAME/hydraulic"), see locations.cpp.
+std::string pointer_of_solver_location(const Problem& p, const std::string& where);
+
+/// Is `relative` ("hydraulic/fluid_density", "density") a key path that
+/// the materials section accepts inside one material (materials.cpp)?
+bool is_material_key_path(std::string_view relative);
+
+// ------------------------------------------------------------- key tables
+/// Appends the accepted keys of the section's objects (for spec_object_keys).
+void grid_keys(std::vector<SpecObjectKeys>& out);
+void material_keys(std::vector<SpecObjectKeys>& out);
+void body_keys(std::vector<SpecObjectKeys>& out);
+void boundary_keys(std::vector<SpecObjectKeys>& out);
+void traction_keys(std::vector<SpecObjectKeys>& out);
+void initial_state_keys(std::vector<SpecObjectKeys>& out);
+void time_keys(std::vector<SpecObjectKeys>& out);
+void output_keys(std::vector<SpecObjectKeys>& out);
+/// The values of the spec's enumerations: output field names (from
+/// hmpm::field_table), traction faces, shape functions.
+Keys field_names();
+Keys traction_faces();
+Keys shape_function_names();
+/// `location` with `keys` as one SpecObjectKeys entry.
+SpecObjectKeys keys_entry(std::string location, Keys keys);
+
+// --------------------------------------------------------------- helpers
+/// "'a', 'b', 'c'".
+std::string quoted_list(const std::vector<std::string>& words);
+/// Grid nodes along `axis` inside the closed interval [lo, hi].
+std::int64_t nodes_inside(const Grid& grid, int axis, double lo, double hi);
+/// Whole grid cells along `axis` inside [lo, hi], with the solver's layout tolerance.
+std::int64_t cells_inside(const Grid& grid, int axis, double lo, double hi);
+
+}  // namespace hmpm::api::parse

@@ -1,0 +1,59 @@
+// tractions.cpp — the "tractions" section: surface loads on a face of the
+// particles inside a box.
+#include "parser.hpp"
+
+namespace hmpm::api::parse {
+namespace {
+
+constexpr std::string_view kTraction[] = {"particles", "face", "traction"};
+constexpr std::string_view kFaces[] = {"x-", "x+", "y-", "y+", "z-", "z+"};
+
+void read_traction(ParseContext& c, const json& j, const std::string& path) {
+  SpecReader& r = c.r;
+  if (!r.object(j, path, kTraction, kTraction)) return;
+  Traction t;
+  if (j.contains("particles")) {
+    bool all = false;
+    if (auto box = read_selection(c, j["particles"], path + "/particles", all)) t.particles = *box;
+  }
+  if (j.contains("face")) {
+    if (auto f = r.one_of(j["face"], path + "/face", kFaces)) {
+      t.axis = (*f)[0] - 'x';
+      t.side = (*f)[1] == '+' ? +1 : -1;
+      if (c.dim > 0 && t.axis >= c.dim)
+        r.error(path + "/face", "is '" + *f + "', but a " + std::to_string(c.dim) +
+                                    "D problem has no " + std::string(kAxisNames[t.axis]) +
+                                    " axis");
+    }
+  }
+  if (j.contains("traction")) {
+    const json& v = j["traction"];
+    const std::string vp = path + "/traction";
+    if (r.per_axis(v, vp, c.dim, "number or formula in t")) {
+      for (std::size_t a = 0; a < v.size() && a < 3; ++a)
+        if (auto f = read_value_of_time(c, v[a], child_pointer(vp, a)))
+          t.traction[a] = std::move(*f);
+    }
+  }
+  c.traction_paths.push_back(path + "/particles");
+  c.p.tractions.push_back(std::move(t));
+}
+
+}  // namespace
+
+void traction_keys(std::vector<SpecObjectKeys>& out) {
+  out.push_back(keys_entry("/tractions/*", kTraction));
+  out.push_back(keys_entry("/tractions/*/particles", selection_key_names()));
+  out.push_back(keys_entry("/tractions/*/particles/box", box_key_names()));
+}
+
+std::span<const std::string_view> traction_faces() {
+  return kFaces;
+}
+
+void read_tractions(ParseContext& c, const json& j, const std::string& path) {
+  if (!c.r.array(j, path)) return;
+  for (std::size_t i = 0; i < j.size(); ++i) read_traction(c, j[i], child_pointer(path, i));
+}
+
+}  // namespace hmpm::api::parse

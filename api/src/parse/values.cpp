@@ -1,0 +1,130 @@
+// values.cpp — values several sections share: boxes, node and particle
+// selections, and numbers-or-formulas of position and of time.
+#include "expression.hpp"
+#include "parser.hpp"
+
+namespace hmpm::api::parse {
+namespace {
+
+constexpr std::string_view kBox[] = {"min", "max"};
+constexpr std::string_view kSelection[] = {"box"};
+
+}  // namespace
+
+Keys box_key_names() {
+  return kBox;
+}
+
+Keys selection_key_names() {
+  return kSelection;
+}
+
+std::optional<Box> read_box(ParseContext& c, const json& j, const std::string& path) {
+  SpecReader& r = c.r;
+  if (!r.object(j, path, kBox, kBox)) return std::nullopt;
+  std::optional<Vec3> lo, hi;
+  if (j.contains("min")) lo = r.vector(j["min"], path + "/min", c.dim);
+  if (j.contains("max")) hi = r.vector(j["max"], path + "/max", c.dim);
+  if (!lo || !hi) return std::nullopt;
+  const Grid& grid = c.p.grid;
+  bool ok = true;
+  for (int a = 0; a < c.dim; ++a) {
+    if ((*hi)[a] < (*lo)[a]) {
+      r.error(child_pointer(path + "/max", a),
+              "is " + format_number((*hi)[a]) + "; must be >= min " + format_number((*lo)[a]));
+      ok = false;
+      continue;
+    }
+    if (!c.grid_ok) continue;
+    const double tol = 1e-9 * (grid.max[a] - grid.min[a]);
+    const std::string range = "; the grid spans [" + format_number(grid.min[a]) + ", " +
+                              format_number(grid.max[a]) + "] along " + std::string(kAxisNames[a]);
+    if ((*lo)[a] < grid.min[a] - tol || (*lo)[a] > grid.max[a] + tol) {
+      r.error(child_pointer(path + "/min", a),
+              "is " + format_number((*lo)[a]) + ", outside the grid" + range);
+      ok = false;
+    }
+    if ((*hi)[a] > grid.max[a] + tol || (*hi)[a] < grid.min[a] - tol) {
+      r.error(child_pointer(path + "/max", a),
+              "is " + format_number((*hi)[a]) + ", outside the grid" + range);
+      ok = false;
+    }
+  }
+  if (!ok) return std::nullopt;
+  return Box{*lo, *hi};
+}
+
+std::optional<Box> read_selection(ParseContext& c, const json& j, const std::string& path,
+                                  bool& all) {
+  all = false;
+  if (j.is_string()) {
+    if (j.get_ref<const std::string&>() == "all") {
+      all = true;
+      return Box{c.p.grid.min, c.p.grid.max};
+    }
+    c.r.error(path,
+              "expected \"all\" or {\"box\": {\"min\": [...], \"max\": [...]}}, got the string '" +
+                  j.get_ref<const std::string&>().substr(0, 64) + "'");
+    return std::nullopt;
+  }
+  if (!j.is_object()) {
+    c.r.error(path,
+              std::string("expected \"all\" or {\"box\": {\"min\": [...], \"max\": [...]}}, got ") +
+                  j.type_name());
+    return std::nullopt;
+  }
+  if (!c.r.object(j, path, kSelection, kSelection) || !j.contains("box")) return std::nullopt;
+  return read_box(c, j["box"], path + "/box");
+}
+
+FieldOfPosition read_value_of_position(ParseContext& c, const json& j, const std::string& path) {
+  if (j.is_string()) {
+    std::string error;
+    if (auto f = compile_field_of_position(j.get_ref<const std::string&>(), error)) {
+      c.position_formulas.push_back({c.p.bodies.size(), path, *f});
+      return *f;
+    }
+    c.r.error(path, error);
+    return {};
+  }
+  if (!j.is_number()) {
+    c.r.error(path, std::string("expected a number or a formula string in x, y, z, got ") +
+                        j.type_name());
+    return {};
+  }
+  if (auto v = c.r.number(j, path)) return constant_field_of_position(*v);
+  return {};
+}
+
+std::optional<FieldOfTime> read_value_of_time(ParseContext& c, const json& j,
+                                              const std::string& path) {
+  if (j.is_string()) {
+    std::string error;
+    if (auto f = compile_field_of_time(j.get_ref<const std::string&>(), error)) {
+      c.time_formulas.push_back({path, *f});
+      return f;
+    }
+    c.r.error(path, error);
+    return std::nullopt;
+  }
+  if (!j.is_number()) {
+    c.r.error(path,
+              std::string("expected a number or a formula string in t, got ") + j.type_name());
+    return std::nullopt;
+  }
+  if (auto v = c.r.number(j, path)) return constant_field_of_time(*v);
+  return std::nullopt;
+}
+
+std::string quoted_list(const std::vector<std::string>& words) {
+  std::string out;
+  for (std::size_t i = 0; i < words.size(); ++i) {
+    if (i) out += ", ";
+    out += '\'';
+    out += words[i];
+    out += '\'';
+  }
+  return out;
+}
+
+}  // namespace hmpm::api::parse

@@ -1,0 +1,91 @@
+// fields.hpp — the output fields: one table, everything else derives from it.
+//
+// A field is a per-particle quantity the solver can write into a series or
+// a snapshot. `field_table` lists each one with its contract name and its
+// kind; from it derive field_name and field_components (here), the names
+// the job-spec parser accepts, the column and array names the result
+// writers produce, and the JSON Schema check (through `hmpm spec-keys`).
+// To add a field: a Field enumerator, its row in field_table (same order),
+// its Snapshot array in run.hpp and its sampling in the solver.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <string_view>
+
+namespace hmpm {
+
+enum class Field : std::uint8_t {
+  position,
+  displacement,
+  velocity,
+  pore_pressure,
+  darcy_velocity,
+  effective_stress,
+  strain,
+  porosity,
+  total_stress,
+};
+
+/// scalar: 1 component; vector: one per axis (dim); tensor: 6 in Voigt
+/// order xx, yy, zz, xy, yz, zx in every dimension.
+enum class FieldKind : std::uint8_t { scalar, vector, tensor };
+
+struct FieldInfo {
+  Field field;
+  std::string_view name;  ///< the contract's name ("pore_pressure", ...)
+  FieldKind kind;
+};
+
+/// Every field, in the order of the Field enumerators.
+inline constexpr std::array<FieldInfo, 9> field_table{{
+    {Field::position, "position", FieldKind::vector},
+    {Field::displacement, "displacement", FieldKind::vector},
+    {Field::velocity, "velocity", FieldKind::vector},
+    {Field::pore_pressure, "pore_pressure", FieldKind::scalar},
+    {Field::darcy_velocity, "darcy_velocity", FieldKind::vector},
+    {Field::effective_stress, "effective_stress", FieldKind::tensor},
+    {Field::strain, "strain", FieldKind::tensor},
+    {Field::porosity, "porosity", FieldKind::scalar},
+    {Field::total_stress, "total_stress", FieldKind::tensor},
+}};
+inline constexpr int field_count = static_cast<int>(field_table.size());
+
+constexpr bool field_table_is_in_enum_order() {
+  for (std::size_t i = 0; i < field_table.size(); ++i)
+    if (static_cast<std::size_t>(field_table[i].field) != i) return false;
+  return true;
+}
+static_assert(field_table_is_in_enum_order(), "field_table rows must follow the Field enumerators");
+
+/// What field_info gives for a value outside the enumerators: "?", one component.
+inline constexpr FieldInfo unknown_field{Field::position, "?", FieldKind::scalar};
+
+constexpr const FieldInfo& field_info(Field f) {
+  const auto i = static_cast<std::size_t>(f);
+  return i < field_table.size() ? field_table[i] : unknown_field;
+}
+
+/// Components of a kind in `dim` dimensions (vectors: dim; tensors: 6; scalars: 1).
+constexpr int kind_components(FieldKind kind, int dim) {
+  return kind == FieldKind::vector ? dim : kind == FieldKind::tensor ? 6 : 1;
+}
+
+/// Number of components a field has in `dim` dimensions (vectors: dim;
+/// tensors: 6 in Voigt order xx, yy, zz, xy, yz, zx; scalars: 1).
+constexpr int field_components(Field f, int dim) {
+  return kind_components(field_info(f).kind, dim);
+}
+
+/// The contract's name of a field ("pore_pressure", ...), NUL-terminated.
+constexpr const char* field_name(Field f) {
+  return field_info(f).name.data();
+}
+
+/// "scalar", "vector" or "tensor".
+constexpr std::string_view kind_name(FieldKind kind) {
+  return kind == FieldKind::vector ? "vector" : kind == FieldKind::tensor ? "tensor" : "scalar";
+}
+
+}  // namespace hmpm
