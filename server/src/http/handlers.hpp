@@ -19,6 +19,11 @@ void get_metrics(Context& c, const httplib::Request& req, httplib::Response& res
 // jobs.cpp — the job collection and one job.
 void post_job(Context& c, const httplib::Request& req, httplib::Response& res,
               const std::string& body);
+/// What POST /jobs does with `spec` (parse, store, queue; idempotency, 503s,
+/// the 201 or 400 answer), for every route that submits a job. `body` is the
+/// request body, the bytes an Idempotency-Key's replay is compared on.
+void submit_job(Context& c, const httplib::Request& req, httplib::Response& res,
+                const std::string& spec, const std::string& body);
 void list_jobs(Context& c, const httplib::Request& req, httplib::Response& res);
 void get_job(Context& c, const httplib::Request& req, httplib::Response& res);
 void get_job_spec(Context& c, const httplib::Request& req, httplib::Response& res);
