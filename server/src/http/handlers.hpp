@@ -1,6 +1,6 @@
 // handlers.hpp — the request handlers, by resource; routes.cpp maps them to paths.
 //
-// Path parameters arrive in `req.matches` (1: job id, 2: result file name).
+// Path parameters arrive in `req.matches` (1: job id or process id, 2: result file name).
 // Authentication, 404 and 405 are the router's business, not theirs.
 #pragma once
 
@@ -35,5 +35,14 @@ void get_result_file(Context& c, const httplib::Request& req, httplib::Response&
 
 // events.cpp — progress as Server-Sent Events.
 void stream_events(Context& c, const httplib::Request& req, httplib::Response& res);
+
+// ogc.cpp — OGC API – Processes: landing page, conformance, the hmpm process.
+// (Job list, status, results and dismissal are the /jobs routes.)
+void get_landing_page(Context& c, const httplib::Request& req, httplib::Response& res);
+void get_conformance(Context& c, const httplib::Request& req, httplib::Response& res);
+void list_processes(Context& c, const httplib::Request& req, httplib::Response& res);
+void get_process(Context& c, const httplib::Request& req, httplib::Response& res);
+void execute_process(Context& c, const httplib::Request& req, httplib::Response& res,
+                     const std::string& body);
 
 }  // namespace hmpm::server::http
