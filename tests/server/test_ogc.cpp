@@ -111,13 +111,16 @@ TEST_F(OgcTest, LandingPageLinksConformanceProcessesAndJobs) {
 
 TEST_F(OgcTest, ABrowserIsSentToTheDashboardAndEveryOtherClientGetsJson) {
   start();
-  auto res = client_->Get("/", {{"Accept", browser_accept}});
-  ASSERT_TRUE(res);
-  EXPECT_EQ(res->status, 303);
-  EXPECT_EQ(res->get_header_value("Location"), "/ui");
+  for (const char* accept : {browser_accept, "text/html", "text/html, application/json",
+                             "application/json;q=0.5, text/html"}) {
+    auto res = client_->Get("/", {{"Accept", accept}});
+    ASSERT_TRUE(res);
+    EXPECT_EQ(res->status, 303) << accept;
+    EXPECT_EQ(res->get_header_value("Location"), "/ui");
+  }
   for (const char* accept : {"", "*/*", "application/json", "text/html;q=0.5, application/json",
-                             "text/html, application/json"}) {
-    res = client_->Get("/", {{"Accept", accept}});
+                             "application/json, text/html"}) {
+    auto res = client_->Get("/", {{"Accept", accept}});
     ASSERT_TRUE(res);
     EXPECT_EQ(res->status, 200) << accept;
     EXPECT_EQ(res->get_header_value("Content-Type"), "application/json") << accept;

@@ -68,17 +68,25 @@ double quality(std::string_view parameters) {
   }
 }
 
-// True when `accept` asks for text/html and rates it above JSON (a browser:
-// "text/html,...,*/*;q=0.8"). Clients that send nothing, */* or JSON get JSON.
+// True when `accept` asks for text/html and does not prefer JSON: a higher
+// q, or on a tie the range listed first (a browser: "text/html,...,*/*;q=0.8").
+// Clients that send nothing, */* or JSON get JSON.
 bool prefers_html(const std::string& accept) {
-  double html = 0.0, json = 0.0;
+  struct Best {
+    double q = 0.0;
+    int position = 0;
+  } html, json;
+  int position = 0;
   for_each_item(accept, [&](const std::string& range, std::string_view parameters) {
     const double q = quality(parameters);
-    if (range == "text/html") html = std::max(html, q);
-    if (range == "application/json" || range == "application/*" || range == "*/*")
-      json = std::max(json, q);
+    ++position;
+    Best* best = range == "text/html" ? &html
+                 : (range == "application/json" || range == "application/*" || range == "*/*")
+                     ? &json
+                     : nullptr;
+    if (best && q > best->q) *best = {q, position};
   });
-  return html > 0.0 && html > json;
+  return html.q > 0.0 && (html.q > json.q || (html.q == json.q && html.position < json.position));
 }
 
 // True when the Prefer header (RFC 7240) asks for an asynchronous answer.
