@@ -8,6 +8,7 @@
 // documents here are static but for the Accept header of the landing page.
 #include <algorithm>
 #include <cctype>
+#include <charconv>
 #include <string_view>
 
 #include "documents.hpp"
@@ -61,11 +62,9 @@ double quality(std::string_view parameters) {
   const std::string p = lower(parameters);
   const std::size_t at = p.find("q=");
   if (at == std::string::npos) return 1.0;
-  try {
-    return std::stod(p.substr(at + 2));
-  } catch (const std::exception&) {
-    return 0.0;
-  }
+  double q = 0.0;  // unreadable: not acceptable
+  std::from_chars(p.data() + at + 2, p.data() + p.size(), q);
+  return q;
 }
 
 // True when `accept` asks for text/html and does not prefer JSON: a higher
