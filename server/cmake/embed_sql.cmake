@@ -2,6 +2,7 @@
 # C++ header (OUTPUT) holding them as raw string literals, in file-name order,
 # so the server never reads a migration from disk at run time.
 # Usage: cmake -DSQL_DIR=dir -DOUTPUT=file.hpp -P embed_sql.cmake
+include(${CMAKE_CURRENT_LIST_DIR}/write_if_changed.cmake)
 file(GLOB files "${SQL_DIR}/*.sql")
 list(SORT files)
 set(text "// Generated from ${SQL_DIR} by server/cmake/embed_sql.cmake; do not edit.\n")
@@ -21,10 +22,4 @@ foreach(file IN LISTS files)
   string(APPEND text "    {${version}, \"${name}\", R\"hmpm_sql(${sql})hmpm_sql\"},\n")
 endforeach()
 string(APPEND text "};\n\n}  // namespace hmpm::server::sqlite\n")
-# Rewrite only on change, so dependants are not rebuilt for nothing.
-if(EXISTS "${OUTPUT}")
-  file(READ "${OUTPUT}" old)
-endif()
-if(NOT old STREQUAL text)
-  file(WRITE "${OUTPUT}" "${text}")
-endif()
+write_if_changed("${OUTPUT}" "${text}")

@@ -1,6 +1,6 @@
 // handlers.hpp — the request handlers, by resource; routes.cpp maps them to paths.
 //
-// Path parameters arrive in `req.matches` (1: job id, 2: result file name).
+// Path parameters arrive in `req.matches` (1: job id or process id, 2: result file name).
 // Authentication, 404 and 405 are the router's business, not theirs.
 #pragma once
 
@@ -19,6 +19,11 @@ void get_metrics(Context& c, const httplib::Request& req, httplib::Response& res
 // jobs.cpp — the job collection and one job.
 void post_job(Context& c, const httplib::Request& req, httplib::Response& res,
               const std::string& body);
+/// What POST /jobs does with `spec` (parse, store, queue; idempotency, 503s,
+/// the 201 or 400 answer), for every route that submits a job. `body` is the
+/// request body, the bytes an Idempotency-Key's replay is compared on.
+void submit_job(Context& c, const httplib::Request& req, httplib::Response& res,
+                const std::string& spec, const std::string& body);
 void list_jobs(Context& c, const httplib::Request& req, httplib::Response& res);
 void get_job(Context& c, const httplib::Request& req, httplib::Response& res);
 void get_job_spec(Context& c, const httplib::Request& req, httplib::Response& res);
@@ -30,5 +35,14 @@ void get_result_file(Context& c, const httplib::Request& req, httplib::Response&
 
 // events.cpp — progress as Server-Sent Events.
 void stream_events(Context& c, const httplib::Request& req, httplib::Response& res);
+
+// ogc.cpp — OGC API – Processes: landing page, conformance, the hmpm process.
+// (Job list, status, results and dismissal are the /jobs routes.)
+void get_landing_page(Context& c, const httplib::Request& req, httplib::Response& res);
+void get_conformance(Context& c, const httplib::Request& req, httplib::Response& res);
+void list_processes(Context& c, const httplib::Request& req, httplib::Response& res);
+void get_process(Context& c, const httplib::Request& req, httplib::Response& res);
+void execute_process(Context& c, const httplib::Request& req, httplib::Response& res,
+                     const std::string& body);
 
 }  // namespace hmpm::server::http

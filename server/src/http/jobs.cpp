@@ -37,6 +37,11 @@ Json spec_issues(const std::vector<hmpm::api::SpecError>& issues) {
 
 void post_job(Context& c, const httplib::Request& req, httplib::Response& res,
               const std::string& body) {
+  submit_job(c, req, res, body, body);
+}
+
+void submit_job(Context& c, const httplib::Request& req, httplib::Response& res,
+                const std::string& spec, const std::string& body) {
   if (c.stopping) {
     res.set_header("Retry-After", "5");
     return send_problem(res, 503, "shutting-down", "Shutting down",
@@ -48,7 +53,7 @@ void post_job(Context& c, const httplib::Request& req, httplib::Response& res,
                         "Idempotency-Key must be at most 255 characters");
   }
 
-  const hmpm::api::ParseResult parsed = hmpm::api::parse_job(body, c.limits);
+  const hmpm::api::ParseResult parsed = hmpm::api::parse_job(spec, c.limits);
   if (!parsed.ok() || !parsed.job) {
     const std::string detail = std::to_string(parsed.errors.size()) +
                                (parsed.errors.size() == 1 ? " problem" : " problems") +
@@ -60,7 +65,7 @@ void post_job(Context& c, const httplib::Request& req, httplib::Response& res,
   NewJob job;
   job.id = new_uuid_v4();
   job.name = parsed.job->name;
-  job.spec = body;
+  job.spec = spec;
   job.cost = cost_of(parsed.job->cost);
   job.idempotency_key = key;
   if (!key.empty()) job.body_sha256 = sha256_hex(body);

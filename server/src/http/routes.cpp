@@ -29,6 +29,12 @@ std::vector<Route> route_table() {
       {Method::get, job + "/results", Access::token, get_manifest},
       {Method::get, job + "/results/(.+)", Access::token, get_result_file},
       {Method::get, job + "/events", Access::token, stream_events},
+      // OGC API – Processes (ogc.cpp); its jobs are the /jobs routes above.
+      {Method::get, "/", Access::token, get_landing_page},
+      {Method::get, "/conformance", Access::token, get_conformance},
+      {Method::get, "/processes", Access::token, list_processes},
+      {Method::get, "/processes/([^/]+)", Access::token, get_process},
+      {Method::post, "/processes/([^/]+)/execution", Access::token, execute_process},
   };
 }
 
