@@ -17,7 +17,8 @@
 #include <random>
 #include <vector>
 
-#include "../../solver/src/constitutive.hpp"
+#include "../../solver/src/materials/drucker_prager.hpp"
+#include "../../solver/src/materials/mohr_coulomb.hpp"
 
 namespace {
 
