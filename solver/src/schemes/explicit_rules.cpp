@@ -17,13 +17,33 @@ namespace hmpm {
 
 namespace {
 
+/// Per material: some body of it has particles. Only those limit the step
+/// (a material no body uses has no wave and no diffusion). When none has
+/// (a Problem check_problem refuses anyway), every material counts.
+std::vector<bool> materials_with_particles(const Problem& problem) {
+  std::vector<bool> used(problem.materials.size(), false);
+  bool any = false;
+  for (const Body& body : problem.bodies) {
+    if (body.material < 0 || body.material >= static_cast<int>(used.size())) continue;
+    if (body.particles_per_cell < 1 || body_layout(problem, body).count == 0) continue;
+    used[static_cast<std::size_t>(body.material)] = true;
+    any = true;
+  }
+  if (!any) used.assign(used.size(), true);
+  return used;
+}
+
+/// The explicit limits over the materials that have particles.
 StableStep explicit_stable_step(const Problem& problem) {
   StableStep s;
   const double h = min_cell_size(problem);
   const double d = problem.dimension;
   s.mechanical = std::numeric_limits<double>::infinity();
   s.hydraulic = std::numeric_limits<double>::infinity();
-  for (const Material& m : problem.materials) {
+  const std::vector<bool> with_particles = materials_with_particles(problem);
+  for (std::size_t i = 0; i < problem.materials.size(); ++i) {
+    if (!with_particles[i]) continue;
+    const Material& m = problem.materials[i];
     const MaterialConstants mc = material_constants(m, problem.gravity_constant);
     const double c = std::sqrt(mc.undrained_p_modulus / mc.mixture_density);
     s.wave_speed = std::max(s.wave_speed, c);
