@@ -37,7 +37,9 @@ struct DruckerPragerConstants {
 /// The mean-stress cut-off is p_t = min(max(tensile_strength, 0), k/alpha).
 inline DruckerPragerConstants make_drucker_prager(const hmpm::DruckerPrager& m) {
   DruckerPragerConstants c;
-  const double phi = std::clamp(m.friction_angle_deg, 0.0, 89.0) * detail::deg_to_rad;
+  // The angle as given, in [0, 90] (the job spec refuses 90 and above; 89
+  // was the clamp once): alpha and k stay well-conditioned up to 90.
+  const double phi = std::clamp(m.friction_angle_deg, 0.0, 90.0) * detail::deg_to_rad;
   const double psi =
       std::clamp(m.dilatancy_angle_deg, 0.0, phi / detail::deg_to_rad) * detail::deg_to_rad;
   const double tp = std::tan(phi), ts = std::tan(psi);

@@ -190,7 +190,12 @@ inline Eigen::Vector3d mohr_coulomb_principal(const Eigen::Vector3d& trial, cons
 /// when c = 0). phi = 0 gives Tresca with no apex.
 inline MohrCoulombConstants make_mohr_coulomb(const hmpm::MohrCoulomb& m) {
   MohrCoulombConstants c;
-  const double phi = std::clamp(m.friction_angle_deg, 0.0, 89.0) * detail::deg_to_rad;
+  // The angle as given, in [0, 90] (the job spec refuses 90 and above; 89
+  // was the clamp once). Up to 89.999 degrees the return lands on the
+  // surface to rounding, except the Mohr-Coulomb corner of the main plane
+  // and a cut-off below the apex, nearly parallel there: |f| up to 2e-5 of
+  // the trial (tests/solver/test_constitutive.cpp, steep angles).
+  const double phi = std::clamp(m.friction_angle_deg, 0.0, 90.0) * detail::deg_to_rad;
   const double psi =
       std::clamp(m.dilatancy_angle_deg, 0.0, phi / detail::deg_to_rad) * detail::deg_to_rad;
   c.sin_phi = std::sin(phi);
