@@ -1,7 +1,8 @@
 // Stress-point tests of the Mohr-Coulomb and Drucker-Prager return mappings
-// (solver/src/constitutive.hpp): elastic states untouched, returned stresses
-// on the yield surface, flow along D : dg/dsigma, closest point for associated
-// flow, apex and edges, the analytical peak of triaxial and plane-strain
+// (solver/src/materials/mohr_coulomb.hpp, drucker_prager.hpp): elastic
+// states untouched, returned stresses on the yield surface, flow along
+// D : dg/dsigma, closest point for associated flow, apex and edges, the
+// analytical peak of triaxial and plane-strain
 // paths, dilatancy and the Tresca limit. The yield functions used to check
 // are written here again from the angles (not from the Constants structs),
 // and evaluated with Eigen's iterative eigen solver, not the closed-form one
