@@ -4,9 +4,9 @@
 
 #include <algorithm>
 #include <cmath>
-#include <sstream>
 
-#include "materials.hpp"
+#include "format.hpp"
+#include "materials/material.hpp"
 #include "particle_layout.hpp"
 
 namespace hmpm {
@@ -88,12 +88,7 @@ double surface_at(const std::vector<BodyExtent>& extents, const Vec3& x, const V
   return top;
 }
 
-std::string fmt(double x) {
-  std::ostringstream o;
-  o.precision(6);
-  o << x;
-  return o.str();
-}
+std::string fmt(double x) { return format_number(x, 6); }
 
 }  // namespace
 

@@ -1,17 +1,19 @@
 // problem.cpp — everything about a Problem that is not the time loop:
-// particle generation and numbering, the stable time step, and the checks
-// that decide whether a Problem can run at all.
+// particle generation and numbering, the stable time step (the scheme's
+// rule, schemes/), and the checks that decide whether a Problem can run at
+// all.
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <sstream>
 #include <stdexcept>
 
+#include "format.hpp"
 #include "geostatic.hpp"
 #include "hmpm/problem.hpp"
 #include "hmpm/run.hpp"
-#include "materials.hpp"
+#include "materials/material.hpp"
 #include "particle_layout.hpp"
+#include "schemes/time_scheme.hpp"
 
 namespace hmpm {
 
@@ -98,41 +100,13 @@ double min_cell_size(const Problem& problem) {
   return h;
 }
 
-StableStep stable_step(const Problem& problem) {
-  StableStep s;
-  const double h = min_cell_size(problem);
-  const double d = problem.dimension;
-  s.mechanical = std::numeric_limits<double>::infinity();
-  s.hydraulic = std::numeric_limits<double>::infinity();
-  for (const Material& m : problem.materials) {
-    const MaterialConstants mc = material_constants(m, problem.gravity_constant);
-    const double c = std::sqrt(mc.undrained_p_modulus / mc.mixture_density);
-    s.wave_speed = std::max(s.wave_speed, c);
-    // Explicit central differences with lumped mass: omega_max <= sqrt(d) 2c/h,
-    // stable for dt <= 2/omega_max = h / (c sqrt(d)).
-    s.mechanical = std::min(s.mechanical, h / (c * std::sqrt(d)));
-    if (m.hydraulic) {
-      // Forward Euler on dp/dt = c_h lap p with lumped storage:
-      // lambda_max = 4 d c_h / h^2, stable for dt <= 2/lambda_max.
-      const double c_h = mc.permeability_over_gamma / mc.storage;
-      s.hydraulic = std::min(s.hydraulic, h * h / (2.0 * d * c_h));
-    }
-  }
-  s.limit = std::min(s.mechanical, s.hydraulic);
-  s.chosen = problem.time.dt ? *problem.time.dt : problem.time.courant * s.limit;
-  return s;
-}
+StableStep stable_step(const Problem& problem) { return scheme_rules(problem).stable_step(problem); }
 
 // ---------------------------------------------------------------- checks
 
 namespace {
 
-std::string fmt(double v) {
-  std::ostringstream o;
-  o.precision(4);
-  o << v;
-  return o.str();
-}
+std::string fmt(double v) { return format_number(v, 4); }
 
 }  // namespace
 
@@ -230,16 +204,8 @@ std::vector<ProblemIssue> check_problem(const Problem& problem) {
   if (problem.time.dt && !(*problem.time.dt > 0)) add("time/dt", "must be > 0");
   if (!issues.empty()) return issues;
 
-  const StableStep s = stable_step(problem);
-  if (problem.time.dt && *problem.time.dt > s.limit * (1.0 + 1e-12)) {
-    std::string why = s.hydraulic < s.mechanical
-                          ? "the explicit hydraulic diffusion limit h^2/(2 d k/(gamma_w Q))"
-                          : "the mechanical limit h/(c sqrt(d)) with undrained wave speed c = " +
-                                fmt(s.wave_speed) + " m/s";
-    add("time/dt", "is " + fmt(*problem.time.dt) + " s, above the stable limit " + fmt(s.limit) +
-                       " s (" + why + "); use dt <= " + fmt(s.limit) +
-                       " or omit dt to let the solver choose " + fmt(0.5 * s.limit) + " s");
-  }
+  const SchemeRules& scheme = scheme_rules(problem);
+  scheme.check(problem, scheme.stable_step(problem), issues);
   const std::int64_t n = count_particles(problem);
   for (std::size_t i = 0; i < problem.output.series_particles.size(); ++i) {
     const std::int64_t p = problem.output.series_particles[i];

@@ -1,26 +1,15 @@
-// run.cpp — entry point: checks a Problem and dispatches to the Simulation
-// instantiated for its dimension and shape function (1D/2D/3D x linear,
-// GIMP, B-spline), so every hot loop is compiled for fixed sizes.
+// run.cpp — entry point: checks a Problem and dispatches to the solver of
+// its dimension (simulation_{1,2,3}d.cpp, each instantiated for the linear,
+// GIMP and B-spline shape functions, so every hot loop is compiled for fixed
+// sizes).
 #include <stdexcept>
+#include <string>
+#include <vector>
 
 #include "hmpm/run.hpp"
-#include "simulation.hpp"
+#include "run_dimension.hpp"
 
 namespace hmpm {
-
-namespace {
-
-template <int Dim>
-RunResult run_dim(const Problem& problem, const RunOptions& options) {
-  switch (problem.shape_function) {
-    case ShapeFunction::gimp: return Simulation<Dim, shape::Gimp>(problem).run(options);
-    case ShapeFunction::bspline: return Simulation<Dim, shape::BSpline>(problem).run(options);
-    case ShapeFunction::linear: break;
-  }
-  return Simulation<Dim, shape::Linear>(problem).run(options);
-}
-
-}  // namespace
 
 RunResult run(const Problem& problem, const RunOptions& options) {
   const std::vector<ProblemIssue> issues = check_problem(problem);
@@ -30,9 +19,12 @@ RunResult run(const Problem& problem, const RunOptions& options) {
     throw std::invalid_argument(msg);
   }
   switch (problem.dimension) {
-    case 1: return run_dim<1>(problem, options);
-    case 2: return run_dim<2>(problem, options);
-    default: return run_dim<3>(problem, options);
+    case 1:
+      return run_dimension<1>(problem, options);
+    case 2:
+      return run_dimension<2>(problem, options);
+    default:
+      return run_dimension<3>(problem, options);
   }
 }
 

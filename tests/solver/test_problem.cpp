@@ -60,6 +60,32 @@ TEST(StableStep, DryBarIsCellOverWaveSpeed) {
   EXPECT_NEAR(s.chosen, 0.5 * s.limit, 1e-18);
 }
 
+// A material no body uses has no particles: its wave speed and diffusion
+// limit must not shorten the step nor refuse a user dt (an unused hydraulic
+// material used to refuse this job with its diffusion limit).
+TEST(StableStep, OnlyMaterialsWithParticlesLimitTheStep) {
+  hmpm::Problem p = bar_problem();
+  hmpm::Material clay;
+  clay.name = "unused clay";
+  clay.density = 2000.0;
+  clay.youngs_modulus = 1e6;
+  hmpm::Hydraulic hy;
+  hy.porosity = 0.4;
+  hy.hydraulic_conductivity = 1e-2;
+  clay.hydraulic = hy;
+  p.materials.push_back(clay);
+  const auto s = hmpm::stable_step(p);
+  EXPECT_NEAR(s.mechanical, (1.0 / 13.0) / std::sqrt(10.0), 1e-15);
+  EXPECT_TRUE(std::isinf(s.hydraulic));
+  EXPECT_NEAR(s.wave_speed, std::sqrt(10.0), 1e-12);
+  p.time.dt = 0.02;  // below the bar's limit 0.0243 s
+  const auto issues = hmpm::check_problem(p);
+  EXPECT_TRUE(issues.empty()) << issues.front().where << ": " << issues.front().message;
+  const hmpm::RunResult r = hmpm::run(p);
+  EXPECT_EQ(r.status, hmpm::RunStatus::successful) << r.message;
+  EXPECT_EQ(r.dt, 0.02);
+}
+
 TEST(StableStep, UserStepAboveLimitIsRefusedWithTheLimit) {
   hmpm::Problem p = bar_problem();
   p.time.dt = 0.1;

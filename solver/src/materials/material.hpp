@@ -1,10 +1,19 @@
-// materials.hpp — material constants derived once from a Material (internal).
+// materials/material.hpp — material constants derived once from a Material,
+// and the one dispatch from a material to its soil model (internal).
 //
 // Everything the hot loops need is precomputed here, so the time step never
-// recomputes moduli or looks anything up by name. The constitutive model is
-// a small enum: the stress update branches on it per particle and calls the
-// closed-form return mapping of constitutive.hpp with the constants stored
-// here (no virtual call, nothing derived from angles in the loop).
+// recomputes moduli or looks anything up by name. The soil model is a small
+// enum: the stress update branches on it per particle and calls the
+// closed-form return mapping of the model's own file (linear_elastic.hpp,
+// mohr_coulomb.hpp, drucker_prager.hpp) with the constants stored here (no
+// virtual call, nothing derived from angles in the loop).
+//
+// Internal state variables: a model declares how many it keeps per particle
+// (`state_variables`); the particle state holds them as a structure of
+// arrays (ParticleState::internal, one array per variable, sized for the
+// largest count among the materials that have particles) and the stress
+// update hands the model its particle's slots (InternalState). The three
+// models of today are perfectly plastic and declare none.
 #pragma once
 
 #include <cmath>
@@ -12,24 +21,50 @@
 #include <limits>
 #include <type_traits>
 #include <variant>
+#include <vector>
 
-#include "constitutive.hpp"
+#include "drucker_prager.hpp"
+#include "elastic.hpp"
 #include "hmpm/problem.hpp"
+#include "linear_elastic.hpp"
+#include "mohr_coulomb.hpp"
 
 namespace hmpm {
 
-/// Which stress update a material uses after the elastic trial.
+/// Which stress update a material uses after the elastic trial: one entry
+/// per file of materials/ (the order is not significant).
 enum class Model : std::uint8_t { linear_elastic, mohr_coulomb, drucker_prager };
+
+/// Number of per-particle internal state variables the model keeps.
+constexpr int state_variable_count(Model m) {
+  switch (m) {
+    case Model::mohr_coulomb:
+      return constitutive::MohrCoulombModel::state_variables;
+    case Model::drucker_prager:
+      return constitutive::DruckerPragerModel::state_variables;
+    case Model::linear_elastic:
+      break;
+  }
+  return constitutive::LinearElasticModel::state_variables;
+}
+
+/// One particle's internal state variables: variable k is arrays[k][p].
+/// Models that declare none never touch it.
+struct InternalState {
+  std::vector<double>* arrays;
+  std::size_t p;
+  double& operator[](int k) const { return arrays[k][p]; }
+};
 
 struct MaterialConstants {
   Model model = Model::linear_elastic;
   constitutive::Elastic elastic{0.0, 0.0};              ///< the trial's lambda and G
   constitutive::MohrCoulombConstants mohr_coulomb;      ///< used when model == mohr_coulomb
   constitutive::DruckerPragerConstants drucker_prager;  ///< used when model == drucker_prager
-  double lambda = 0.0;               ///< Lame's first parameter, Pa
-  double shear_modulus = 0.0;        ///< G, Pa
-  double constrained_modulus = 0.0;  ///< E(1-nu)/((1+nu)(1-2nu)), Pa
-  double mixture_density = 0.0;      ///< kg/m^3
+  double lambda = 0.0;                                  ///< Lame's first parameter, Pa
+  double shear_modulus = 0.0;                           ///< G, Pa
+  double constrained_modulus = 0.0;                     ///< E(1-nu)/((1+nu)(1-2nu)), Pa
+  double mixture_density = 0.0;                         ///< kg/m^3
   bool saturated = false;
   double porosity = 0.0;
   double storage = 0.0;              ///< Q = (1-n)/Ks + n/Kf, 1/Pa
@@ -66,7 +101,8 @@ inline MaterialConstants material_constants(const Material& m, double gravity_co
     c.porosity = h.porosity;
     c.fluid_density = h.fluid_density;
     c.mixture_density = (1 - h.porosity) * m.density + h.porosity * h.fluid_density;
-    const double solid_term = std::isinf(h.solid_bulk_modulus) ? 0.0 : (1 - h.porosity) / h.solid_bulk_modulus;
+    const double solid_term =
+        std::isinf(h.solid_bulk_modulus) ? 0.0 : (1 - h.porosity) / h.solid_bulk_modulus;
     c.storage = solid_term + h.porosity / h.fluid_bulk_modulus;
     c.undrained_p_modulus += 1.0 / c.storage;
     c.permeability_over_gamma = h.hydraulic_conductivity / (h.fluid_density * gravity_constant);
@@ -84,8 +120,28 @@ inline MaterialConstants material_constants(const Material& m, double gravity_co
 /// E Q rho_f / (rho - rho_f): above 1 the material is in that regime
 /// (infinity when the grains are not denser than the fluid), 0 when the
 /// term is dropped or nothing flows.
+/// Plastic correction of the elastic trial stress (effective stress, so dry
+/// and saturated alike): the closed-form return mapping of the material's
+/// model; linear-elastic materials in a run with plastic ones pass through.
+/// `state` is the particle's internal state variables (materials/ models
+/// that declare none ignore it).
+inline void return_to_yield_surface(constitutive::Voigt& sig, const MaterialConstants& mc,
+                                    [[maybe_unused]] InternalState state) {
+  switch (mc.model) {
+    case Model::mohr_coulomb:
+      constitutive::return_mohr_coulomb(sig, mc.elastic, mc.mohr_coulomb);
+      break;
+    case Model::drucker_prager:
+      constitutive::return_drucker_prager(sig, mc.elastic, mc.drucker_prager);
+      break;
+    case Model::linear_elastic:
+      break;
+  }
+}
+
 inline double darcy_inertia_growth_ratio(const MaterialConstants& c) {
-  if (!c.saturated || c.darcy_inertia_density <= 0.0 || c.permeability_over_gamma <= 0.0) return 0.0;
+  if (!c.saturated || c.darcy_inertia_density <= 0.0 || c.permeability_over_gamma <= 0.0)
+    return 0.0;
   const double buoyant = c.mixture_density - c.fluid_density;
   if (buoyant <= 0.0) return std::numeric_limits<double>::infinity();
   return c.constrained_modulus * c.storage * c.fluid_density / buoyant;

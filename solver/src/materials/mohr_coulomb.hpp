@@ -1,35 +1,17 @@
-// constitutive.hpp — stress-point algorithms for perfectly plastic soils (internal).
+// materials/mohr_coulomb.hpp — the Mohr-Coulomb soil model (internal): its
+// constants, derived once per material, and its return mapping.
 //
-// The explicit time step updates each particle's effective stress with an
-// elastic predictor (the full strain increment through linear isotropic
-// elasticity) and then calls one of the functions here to bring the trial
-// stress back onto the yield surface. Both models are perfectly plastic and
-// have linear yield functions in their natural stress coordinates, so the
+// Perfectly plastic, linear yield planes in principal stress space, so the
 // return is closed form: no iteration, no allocation, no virtual call and no
 // exception, which is what a per-particle, per-step routine must be.
-//
-//  * Mohr-Coulomb works in principal stress space (closed-form 3x3 spectral
-//    decomposition). Non-associated flow with dilatancy psi, a tension
-//    cut-off on the major principal stress, and returns to the main plane,
-//    to the triaxial compression and extension edges and to the apex, chosen
-//    by the closed-form region tests of the multi-plane algorithm (Clausen,
-//    Damkilde & Andersen 2006/2007; derived here, not copied).
-//  * Drucker-Prager works with (p, sqrt(J2)): return to the cone, to the
-//    tension cut-off on the mean stress, or to the corner/apex where the two
-//    meet. No spectral decomposition.
-//
-// Conventions: stress as Voigt xx, yy, zz, xy, yz, zx (tensor components),
-// Pa, compression negative (effective stress for saturated soils: the caller
-// passes sigma' and adds the pore pressure itself). Principal stresses are
-// ordered algebraically s1 >= s2 >= s3, so s3 is the most compressive.
-// Dilatancy angles are clamped into [0, phi]: psi > phi is unphysical and
-// psi < 0 (contractive flow) is not supported by the region tests.
-//
-// Each return function reports ||d eps_p||, the Frobenius norm of the plastic
-// strain increment. For a single smooth surface this is the plastic
-// multiplier of the unit-normalised plastic potential; it is also the
-// increment of the usual accumulated plastic strain, and 0 exactly when the
-// step was elastic (the stress is then left bitwise untouched).
+// Closed-form 3x3 spectral decomposition; non-associated flow with
+// dilatancy psi, a tension cut-off on the major principal stress, and
+// returns to the main plane, to the triaxial compression and extension edges
+// and to the apex, chosen by the closed-form region tests of the multi-plane
+// algorithm (Clausen, Damkilde & Andersen 2006/2007; derived here, not
+// copied). Dilatancy angles are clamped into [0, phi]: psi > phi is
+// unphysical and psi < 0 (contractive flow) is not supported by the region
+// tests. Conventions: see elastic.hpp.
 #pragma once
 
 #include <Eigen/Core>
@@ -42,17 +24,10 @@
 #include <tuple>
 #include <type_traits>
 
+#include "elastic.hpp"
 #include "hmpm/problem.hpp"
 
 namespace hmpm::constitutive {
-
-using Voigt = Eigen::Matrix<double, 6, 1>;
-
-/// Linear isotropic elasticity: Lame's lambda and the shear modulus G, Pa (G > 0).
-struct Elastic {
-  double lambda;
-  double shear;
-};
 
 /// A linear yield plane in ordered principal stress space:
 /// f = normal . s - offset, plastic flow along `flow` (dg/ds).
@@ -81,33 +56,7 @@ struct MohrCoulombConstants {
   std::array<PrincipalPlane, 6> planes;
 };
 
-/// Drucker-Prager constants, computed once per material by make_drucker_prager.
-/// With p = tr(sigma)/3 (negative in compression) and J2 = s:s/2:
-///   f  = sqrt(J2) + alpha p - k          (alpha >= 0: compression strengthens)
-///   g  = sqrt(J2) + alpha_psi p
-///   ft = p - mean_tension_cutoff
-struct DruckerPragerConstants {
-  double alpha = 0.0;
-  double k = 0.0;  ///< Pa
-  double alpha_psi = 0.0;
-  double mean_tension_cutoff = 0.0;  ///< p_t = min(max(tensile_strength, 0), k/alpha), Pa
-};
-
 namespace detail {
-
-constexpr double deg_to_rad = 3.14159265358979323846 / 180.0;
-
-/// D b for the isotropic stiffness in principal space: lambda tr(b) 1 + 2G b.
-inline Eigen::Vector3d stiffness_times(const Elastic& el, const Eigen::Vector3d& b) {
-  return Eigen::Vector3d::Constant(el.lambda * b.sum()) + 2.0 * el.shear * b;
-}
-
-/// C^-1 x (compliance) in principal space: x/(2G) - lambda/(2G(3 lambda + 2G)) tr(x) 1.
-inline Eigen::Vector3d compliance_times(const Elastic& el, const Eigen::Vector3d& x) {
-  const double two_g = 2.0 * el.shear;
-  return x / two_g -
-         Eigen::Vector3d::Constant(el.lambda / (two_g * (3.0 * el.lambda + two_g)) * x.sum());
-}
 
 /// Solves the closed-form return onto the intersection of the M planes in
 /// `active`: s = trial - sum_j dl_j D b_j with f_i(s) = 0 for every active i.
@@ -232,13 +181,6 @@ inline Eigen::Vector3d mohr_coulomb_principal(const Eigen::Vector3d& trial, cons
   return best_stress;
 }
 
-/// Voigt stress -> symmetric 3x3 tensor.
-inline Eigen::Matrix3d to_tensor(const Voigt& v) {
-  Eigen::Matrix3d m;
-  m << v(0), v(3), v(5), v(3), v(1), v(4), v(5), v(4), v(2);
-  return m;
-}
-
 }  // namespace detail
 
 /// Precomputes the Mohr-Coulomb constants of `m` (angles in degrees, c and
@@ -248,7 +190,12 @@ inline Eigen::Matrix3d to_tensor(const Voigt& v) {
 /// when c = 0). phi = 0 gives Tresca with no apex.
 inline MohrCoulombConstants make_mohr_coulomb(const hmpm::MohrCoulomb& m) {
   MohrCoulombConstants c;
-  const double phi = std::clamp(m.friction_angle_deg, 0.0, 89.0) * detail::deg_to_rad;
+  // The angle as given, in [0, 90] (the job spec refuses 90 and above; 89
+  // was the clamp once). Up to 89.999 degrees the return lands on the
+  // surface to rounding, except the Mohr-Coulomb corner of the main plane
+  // and a cut-off below the apex, nearly parallel there: |f| up to 2e-5 of
+  // the trial (tests/solver/test_constitutive.cpp, steep angles).
+  const double phi = std::clamp(m.friction_angle_deg, 0.0, 90.0) * detail::deg_to_rad;
   const double psi =
       std::clamp(m.dilatancy_angle_deg, 0.0, phi / detail::deg_to_rad) * detail::deg_to_rad;
   c.sin_phi = std::sin(phi);
@@ -270,27 +217,6 @@ inline MohrCoulombConstants make_mohr_coulomb(const hmpm::MohrCoulomb& m) {
   return c;
 }
 
-/// Precomputes the Drucker-Prager constants of `m` (angles in degrees, Pa).
-/// Plane-strain match to Mohr-Coulomb (the classical fit, exact for
-/// associated flow in plane strain at the limit state, d eps_zz^p = 0):
-///   alpha = 3 tan phi / sqrt(9 + 12 tan^2 phi),  k = 3 c / sqrt(9 + 12 tan^2 phi),
-///   alpha_psi = the same expression in psi (clamped into [0, phi]).
-/// The mean-stress cut-off is p_t = min(max(tensile_strength, 0), k/alpha).
-inline DruckerPragerConstants make_drucker_prager(const hmpm::DruckerPrager& m) {
-  DruckerPragerConstants c;
-  const double phi = std::clamp(m.friction_angle_deg, 0.0, 89.0) * detail::deg_to_rad;
-  const double psi =
-      std::clamp(m.dilatancy_angle_deg, 0.0, phi / detail::deg_to_rad) * detail::deg_to_rad;
-  const double tp = std::tan(phi), ts = std::tan(psi);
-  const double root = std::sqrt(9.0 + 12.0 * tp * tp);
-  c.alpha = 3.0 * tp / root;
-  c.k = 3.0 * std::max(m.cohesion, 0.0) / root;
-  c.alpha_psi = 3.0 * ts / std::sqrt(9.0 + 12.0 * ts * ts);
-  const double apex = c.alpha > 0.0 ? c.k / c.alpha : std::numeric_limits<double>::infinity();
-  c.mean_tension_cutoff = std::min(std::max(m.tensile_strength, 0.0), apex);
-  return c;
-}
-
 /// Mohr-Coulomb return mapping. `stress` holds the elastic trial stress
 /// (Voigt, Pa, compression negative) on entry and the returned stress on
 /// exit; `el` is the elasticity that made the trial. Elastic trials are
@@ -299,8 +225,12 @@ inline DruckerPragerConstants make_drucker_prager(const hmpm::DruckerPrager& m) 
 /// (closed-form 3x3 eigen solver), returned in principal space and rotated
 /// back with the same eigenvectors (a hydrostatic result is set exactly).
 /// Returns ||d eps_p|| >= 0 (0 if elastic). Never throws, never allocates.
-inline double return_mohr_coulomb(Voigt& stress, const Elastic& el,
-                                  const MohrCoulombConstants& mc) {
+/// Kept out of line (noinline): inlined into the stress phase, its cheap
+/// elastic test would be fused with the phase's arithmetic (FMA
+/// contraction), which changes the rounding of every plastic run and buys
+/// nothing measurable.
+[[gnu::noinline]] inline double return_mohr_coulomb(Voigt& stress, const Elastic& el,
+                                                    const MohrCoulombConstants& mc) {
   // Cheap elastic test: with s the deviator, s1 - s3 <= 2 sqrt(J2),
   // s1 + s3 = 2p - s2 <= 2p + sqrt(J2/3) and s1 <= p + 2 sqrt(J2/3).
   const double p = (stress(0) + stress(1) + stress(2)) / 3.0;
@@ -335,52 +265,15 @@ inline double return_mohr_coulomb(Voigt& stress, const Elastic& el,
   return detail::compliance_times(el, trial - r).norm();
 }
 
-/// Drucker-Prager return mapping. `stress` holds the elastic trial stress
-/// (Voigt, Pa, compression negative) on entry and the returned stress on
-/// exit. In (p, sqrt(J2)) the return is: to the cone along
-/// (K alpha_psi, G) when that lands at p <= p_t with sqrt(J2) >= 0; else to
-/// the cut-off p = p_t with the deviator kept, if that is inside the cone;
-/// else to the corner p = p_t, sqrt(J2) = k - alpha p_t (the apex when
-/// p_t = k/alpha). The deviator keeps its direction throughout. Elastic
-/// trials are left bitwise untouched. Returns ||d eps_p|| >= 0 (0 if elastic).
-inline double return_drucker_prager(Voigt& stress, const Elastic& el,
-                                    const DruckerPragerConstants& dp) {
-  const double p = (stress(0) + stress(1) + stress(2)) / 3.0;
-  const double dx = stress(0) - p, dy = stress(1) - p, dz = stress(2) - p;
-  const double q = std::sqrt(0.5 * (dx * dx + dy * dy + dz * dz) + stress(3) * stress(3) +
-                             stress(4) * stress(4) + stress(5) * stress(5));
-  const double f = q + dp.alpha * p - dp.k;
-  const double pt = dp.mean_tension_cutoff;
-  if (f <= 0.0 && p <= pt) return 0.0;
-
-  const double g = el.shear, bulk = el.lambda + 2.0 * g / 3.0;
-  const double tol = 1e-13 * (std::abs(p) + q + dp.k);
-  double p_new = pt, q_new = q;
-  bool done = false;
-  if (f > 0.0) {  // cone
-    const double dl = f / (g + bulk * dp.alpha * dp.alpha_psi);
-    const double qc = q - g * dl, pc = p - bulk * dp.alpha_psi * dl;
-    if (qc >= 0.0 && pc <= pt + tol) {
-      p_new = pc;
-      q_new = qc;
-      done = true;
-    }
+/// The model as the stress update sees it: its constants, its return
+/// mapping and the number of per-particle internal state variables it keeps
+/// (ParticleState::internal). Perfectly plastic: none.
+struct MohrCoulombModel {
+  using Constants = MohrCoulombConstants;
+  static constexpr int state_variables = 0;
+  static inline void return_stress(Voigt& sig, const Elastic& el, const Constants& c) {
+    return_mohr_coulomb(sig, el, c);
   }
-  if (!done && !(p > pt && q + dp.alpha * pt - dp.k <= 0.0)) {
-    q_new = std::max(dp.k - dp.alpha * pt, 0.0);  // corner / apex
-  }
-  const double ratio = q > 0.0 ? q_new / q : 0.0;
-  if (q_new == 0.0) {
-    stress << p_new, p_new, p_new, 0.0, 0.0, 0.0;  // apex: exactly hydrostatic
-  } else if (q_new == q) {
-    stress.head<3>().array() += p_new - p;  // cut-off: deviator untouched
-  } else {
-    stress.head<3>() << p_new + ratio * dx, p_new + ratio * dy, p_new + ratio * dz;
-    stress.tail<3>() *= ratio;
-  }
-  const double dq = q - q_new, dpm = p - p_new;
-  // ||d eps_p||^2 = ||ds||^2/(4G^2) + 3 (dp/(3K))^2, with ||ds|| = sqrt(2) dq.
-  return std::sqrt(dq * dq / (2.0 * g * g) + dpm * dpm / (3.0 * bulk * bulk));
-}
+};
 
 }  // namespace hmpm::constitutive

@@ -1,112 +1,48 @@
-// simulation_run.hpp — the time loop around Simulation::step: time-step
-// control, output sampling, progress, cancellation and failure reports
-// (internal; included by simulation.hpp).
+// time_loop.hpp — the time loop around a time scheme's step: time-step
+// control, output sampling, progress, cancellation, the wall-time limit and
+// failure reports (internal). The scheme (schemes/) owns the step and its
+// stable-step rule; this loop owns everything between steps.
 #pragma once
 
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <sstream>
+#include <string>
+#include <thread>
+
+#include "output.hpp"
+#include "schemes/explicit_scheme.hpp"
+#include "schemes/time_scheme.hpp"
+#include "simulation.hpp"
+
 namespace hmpm {
-
-template <int Dim, class Shape>
-void Simulation<Dim, Shape>::fill_snapshot(Snapshot& snap, const std::vector<Field>& fields) const {
-  const std::size_t n = particles_.size();
-  snap.dimension = Dim;
-  snap.particles = static_cast<std::int64_t>(n);
-  snap.fields = fields;
-  auto vec3 = [&](std::vector<double>& out, const std::vector<Vec>& in) {
-    out.assign(3 * n, 0.0);
-    if (in.empty()) return;
-    for (std::size_t p = 0; p < n; ++p)
-      for (int a = 0; a < Dim; ++a) out[3 * p + a] = in[p][a];
-  };
-  auto voigt = [&](std::vector<double>& out, const std::vector<Voigt>& in) {
-    out.resize(6 * n);
-    for (std::size_t p = 0; p < n; ++p)
-      for (int c = 0; c < 6; ++c) out[6 * p + c] = in[p][c];
-  };
-  auto scalar = [&](std::vector<double>& out, const std::vector<double>& in) {
-    if (in.empty()) out.assign(n, 0.0);
-    else out.assign(in.begin(), in.end());
-  };
-  for (Field f : fields) {
-    switch (f) {
-      case Field::position: vec3(snap.position, particles_.x); break;
-      case Field::displacement: {
-        snap.displacement.assign(3 * n, 0.0);
-        for (std::size_t p = 0; p < n; ++p)
-          for (int a = 0; a < Dim; ++a) snap.displacement[3 * p + a] = particles_.x[p][a] - particles_.x0[p][a];
-        break;
-      }
-      case Field::velocity: vec3(snap.velocity, particles_.v); break;
-      case Field::darcy_velocity: vec3(snap.darcy_velocity, particles_.darcy); break;
-      case Field::pore_pressure: scalar(snap.pore_pressure, particles_.pressure_out); break;
-      case Field::porosity: scalar(snap.porosity, particles_.porosity); break;
-      case Field::effective_stress: voigt(snap.effective_stress, particles_.stress); break;
-      case Field::strain: voigt(snap.strain, particles_.strain); break;
-      case Field::total_stress: {
-        voigt(snap.total_stress, particles_.stress);
-        if (!particles_.pressure_out.empty())
-          for (std::size_t p = 0; p < n; ++p)
-            for (int c = 0; c < 3; ++c) snap.total_stress[6 * p + c] -= particles_.pressure_out[p];
-        break;
-      }
-    }
-  }
-  snap.volume.assign(particles_.volume.begin(), particles_.volume.end());
-  snap.mass.assign(particles_.mass.begin(), particles_.mass.end());
-  snap.material.assign(particles_.material.begin(), particles_.material.end());
-}
-
-template <int Dim, class Shape>
-void Simulation<Dim, Shape>::sample_series(Series& series, double t) const {
-  series.time.push_back(t);
-  for (std::size_t f = 0; f < series.fields.size(); ++f) {
-    std::vector<double>& out = series.values[f];
-    for (std::int64_t pi : series.particles) {
-      const auto p = static_cast<std::size_t>(pi);
-      switch (series.fields[f]) {
-        case Field::position: for (int a = 0; a < Dim; ++a) out.push_back(particles_.x[p][a]); break;
-        case Field::displacement:
-          for (int a = 0; a < Dim; ++a) out.push_back(particles_.x[p][a] - particles_.x0[p][a]);
-          break;
-        case Field::velocity: for (int a = 0; a < Dim; ++a) out.push_back(particles_.v[p][a]); break;
-        case Field::darcy_velocity:
-          for (int a = 0; a < Dim; ++a) out.push_back(particles_.darcy.empty() ? 0.0 : particles_.darcy[p][a]);
-          break;
-        case Field::pore_pressure:
-          out.push_back(particles_.pressure_out.empty() ? 0.0 : particles_.pressure_out[p]);
-          break;
-        case Field::porosity:
-          out.push_back(particles_.porosity.empty() ? 0.0 : particles_.porosity[p]);
-          break;
-        case Field::effective_stress: for (int c = 0; c < 6; ++c) out.push_back(particles_.stress[p][c]); break;
-        case Field::strain: for (int c = 0; c < 6; ++c) out.push_back(particles_.strain[p][c]); break;
-        case Field::total_stress: {
-          const double pw = particles_.pressure_out.empty() ? 0.0 : particles_.pressure_out[p];
-          for (int c = 0; c < 6; ++c) out.push_back(particles_.stress[p][c] - (c < 3 ? pw : 0.0));
-          break;
-        }
-      }
-    }
-  }
-}
 
 template <int Dim, class Shape>
 RunResult Simulation<Dim, Shape>::run(const RunOptions& options) {
   using clock = std::chrono::steady_clock;
   RunResult result;
-  stable_ = stable_step(problem_);
+  ExplicitScheme<Dim, Shape> scheme(*this);
+  TimeScheme& time_scheme = scheme;  // the loop sees the interface only
+  stable_ = time_scheme.stable_step(problem_);
   const double dt = stable_.chosen;
   const double end = problem_.time.end;
-  const auto total = std::max<std::int64_t>(1, static_cast<std::int64_t>(std::ceil(end / dt - 1e-9)));
+  const auto total =
+      std::max<std::int64_t>(1, static_cast<std::int64_t>(std::ceil(end / dt - 1e-9)));
   double min_mass = std::numeric_limits<double>::infinity();
   for (double m : particles_.mass) min_mass = std::min(min_mass, m);
   mass_tolerance_ = particles_.size() ? 1e-12 * min_mass : 0.0;
   // Threads: every core when asked for <= 0, but at least
   // min_particles_per_thread particles each.
-  int threads = options.threads > 0 ? options.threads
-                                    : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
-  threads = static_cast<int>(std::clamp<std::int64_t>(
-      static_cast<std::int64_t>(particles_.size()) / std::max<std::int64_t>(1, options.min_particles_per_thread),
-      1, threads));
+  int threads = options.threads > 0
+                    ? options.threads
+                    : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  threads = static_cast<int>(
+      std::clamp<std::int64_t>(static_cast<std::int64_t>(particles_.size()) /
+                                   std::max<std::int64_t>(1, options.min_particles_per_thread),
+                               1, threads));
   setup_threads(threads);
 
   result.dt = dt;
@@ -171,7 +107,7 @@ RunResult Simulation<Dim, Shape>::run(const RunOptions& options) {
       break;
     }
     const double t_new = (n + 1 == total) ? end : static_cast<double>(n + 1) * dt;
-    step(t, t_new - t);
+    time_scheme.step(t, t_new - t);
     if (failed_) {
       std::ostringstream where;
       if (failure_particle_ >= 0) {  // -1: a failure of the run, not of a particle

@@ -1,0 +1,125 @@
+// boundary/constraints.hpp — boundary conditions compiled to node lists (internal).
+//
+// Each Boundary of the Problem is compiled once, at set-up, into the
+// constraints it imposes on the grid: prescribed velocity components
+// (VelocityConstraint, optionally with Coulomb friction), rigid ties
+// (RigidTie: nodes sharing one velocity component) and prescribed pore
+// pressure (PressureConstraint). Which one wins where several meet at a node
+// is decided in one place, boundary/apply.hpp. Surface loads are in
+// boundary/tractions.hpp. Set-up code: allocates, never runs per step.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <utility>
+#include <vector>
+
+#include "hmpm/problem.hpp"
+#include "state/grid.hpp"
+
+namespace hmpm {
+
+/// Velocity components prescribed at a set of nodes, optionally with friction.
+struct VelocityConstraint {
+  std::vector<std::int64_t> nodes;
+  std::array<bool, 3> fixed{false, false, false};
+  std::array<const FieldOfTime*, 3> fn{nullptr, nullptr, nullptr};
+  int normal = 0;  ///< the prescribed axis (used with friction)
+  /// Side of the material for friction: +1 when the wall is the grid's min
+  /// face along `normal` (material at larger coordinates), -1 for the max
+  /// face, 0 for a wall inside the grid (either side).
+  int inward = 0;
+  double friction = 0;  ///< Coulomb coefficient mu; inf = no slip
+  /// Per node: tangential velocity cancelled by friction this step.
+  /// Empty when the boundary has no friction.
+  std::vector<std::uint8_t> stuck;
+
+  bool has_friction() const { return !stuck.empty(); }
+};
+
+/// Nodes sharing one velocity component per marked axis (rigid plate).
+struct RigidTie {
+  std::vector<std::int64_t> nodes;
+  std::array<bool, 3> axes{false, false, false};
+  std::array<double, 3> remapped{0.0, 0.0, 0.0};  ///< scratch: tied re-mapped velocity
+};
+
+/// Pore pressure prescribed at a set of nodes.
+struct PressureConstraint {
+  std::vector<std::int64_t> nodes;
+  const FieldOfTime* fn = nullptr;
+};
+
+/// Every constraint of a run.
+struct Constraints {
+  std::vector<VelocityConstraint> velocity;
+  std::vector<RigidTie> rigid_ties;
+  std::vector<PressureConstraint> pressure;
+  /// Per node (saturated runs): bit a set when a boundary prescribes or ties
+  /// component a. Empty in dry runs.
+  std::vector<std::uint8_t> prescribed_axes;
+};
+
+namespace detail {
+
+template <int Dim>
+bool node_in_box(const GridState<Dim>& grid, std::int64_t i, const Box& box) {
+  const VecD<Dim> xn = grid.node_position(i);
+  for (int a = 0; a < Dim; ++a) {
+    const double tol = 1e-9 * grid.h[a];
+    if (xn[a] < box.min[a] - tol || xn[a] > box.max[a] + tol) return false;
+  }
+  return true;
+}
+
+}  // namespace detail
+
+/// Compiles the boundaries of `problem` on `grid` (whose upper corner is
+/// `grid_max`). Pressure constraints only when `fluid` (a saturated run).
+/// `problem` must outlive the result (the constraints point to its fields).
+template <int Dim>
+Constraints compile_constraints(const Problem& problem, const GridState<Dim>& grid,
+                                const VecD<Dim>& grid_max, bool fluid) {
+  Constraints c;
+  for (const Boundary& b : problem.boundaries) {
+    std::vector<std::int64_t> nodes;
+    for (std::int64_t i = 0; i < grid.count; ++i)
+      if (b.nodes.all || detail::node_in_box(grid, i, b.nodes.box)) nodes.push_back(i);
+    if (b.has_velocity) {
+      VelocityConstraint vc;
+      vc.nodes = nodes;
+      for (int a = 0; a < Dim; ++a)
+        if (b.velocity[a]) {
+          vc.fixed[a] = true;
+          vc.fn[a] = &*b.velocity[a];
+          vc.normal = a;  // unique when friction is given (check_problem)
+        }
+      if (b.friction) {
+        vc.friction = *b.friction;
+        vc.stuck.assign(vc.nodes.size(), 0);
+        const int n = vc.normal;
+        const double tol = 1e-9 * grid.h[n];
+        if (!b.nodes.all && b.nodes.box.max[n] <= grid.origin[n] + tol) vc.inward = 1;
+        if (!b.nodes.all && b.nodes.box.min[n] >= grid_max[n] - tol) vc.inward = -1;
+      }
+      c.velocity.push_back(std::move(vc));
+    }
+    if (b.rigid[0] || b.rigid[1] || b.rigid[2]) c.rigid_ties.push_back({nodes, b.rigid});
+    if (b.pore_pressure && fluid) c.pressure.push_back({std::move(nodes), &*b.pore_pressure});
+  }
+  if (!fluid) return c;
+  c.prescribed_axes.assign(static_cast<std::size_t>(grid.count), 0);
+  for (const VelocityConstraint& bc : c.velocity)
+    for (int a = 0; a < Dim; ++a)
+      if (bc.fixed[a])
+        for (std::int64_t i : bc.nodes)
+          c.prescribed_axes[static_cast<std::size_t>(i)] |= std::uint8_t(1u << a);
+  for (const RigidTie& tie : c.rigid_ties)
+    for (int a = 0; a < Dim; ++a)
+      if (tie.axes[a])
+        for (std::int64_t i : tie.nodes)
+          c.prescribed_axes[static_cast<std::size_t>(i)] |= std::uint8_t(1u << a);
+  return c;
+}
+
+}  // namespace hmpm

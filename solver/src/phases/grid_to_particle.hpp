@@ -1,0 +1,54 @@
+// phases/grid_to_particle.hpp — nodal velocities and accelerations back to
+// the particles: the FLIP velocity update with the MUSL re-map, and the
+// particle motion (internal).
+#pragma once
+
+#include <cstdint>
+
+#include "simulation.hpp"
+
+namespace hmpm {
+
+/// Phase 3: FLIP update of particle velocities, v_p += dt sum N_i a_i, and
+/// re-mapping of the updated momentum (MUSL, Eq. 26).
+template <int Dim, class Shape>
+inline void Simulation<Dim, Shape>::update_particle_velocities_and_remap(const Out& out,
+                                                                         std::size_t begin,
+                                                                         std::size_t end,
+                                                                         double dt) {
+  StencilT s;
+  for (std::size_t p = begin; p < end; ++p) {
+    stencil_in_step<false, true>(p, s);
+    Vec a = Vec::Zero();
+    for (int k = 0; k < StencilT::N; ++k) a += s.w[k] * grid_.accel[s.node[k]];
+    particles_.v[p] += dt * a;
+    const Vec mv = particles_.mass[p] * particles_.v[p];
+    for (int k = 0; k < StencilT::N; ++k) at<nodal::remap>(out)[s.node[k]] += s.w[k] * mv;
+  }
+}
+
+/// Moves the particle with the Lagrangian nodal velocity. One test per
+/// axis catches both failures: a non-finite position (the comparisons are
+/// false for NaN) and a position outside the grid. A non-finite particle
+/// velocity, stress or force makes the nodal velocities, hence the
+/// position, non-finite in the same or the next step.
+template <int Dim, class Shape>
+__attribute__((always_inline)) inline void Simulation<Dim, Shape>::move_particle(std::size_t p,
+                                                                                 const StencilT& s,
+                                                                                 double dt) {
+  Vec dx = Vec::Zero();
+  for (int k = 0; k < StencilT::N; ++k) dx += s.w[k] * grid_.velocity[s.node[k]];
+  dx *= dt;
+  Vec& x = particles_.x[p];
+  x += dx;
+  bool inside = true;
+  for (int a = 0; a < Dim; ++a) inside &= (x[a] >= grid_.origin[a]) & (x[a] <= grid_max_[a]);
+  if (!inside) [[unlikely]] {
+    if (!x.allFinite() || !particles_.v[p].allFinite())
+      fail_nonfinite(p, "velocity");
+    else
+      fail_left_grid(p);
+  }
+}
+
+}  // namespace hmpm

@@ -1,0 +1,77 @@
+// phases/pore_pressure.hpp — the pore pressure phases of saturated runs:
+// nodal pressure from the particles, its force on the mixture, the nodal
+// pressure increment from the fluid flux, and the particle pressure and
+// position update (internal).
+#pragma once
+
+#include <cmath>
+#include <cstdint>
+
+#include "boundary/apply.hpp"
+#include "simulation.hpp"
+
+namespace hmpm {
+
+/// Nodal pressure = storage-weighted average of particle pressures, then
+/// prescribed values at time t.
+template <int Dim, class Shape>
+inline void Simulation<Dim, Shape>::compute_nodal_pressure(double t) {
+  for_nodes([&](std::int64_t b, std::int64_t e) {
+    for (std::int64_t i = b; i < e; ++i)
+      grid_.pressure[i] = grid_.storage[i] > 0 ? grid_.pressure[i] / grid_.storage[i] : 0.0;
+  });
+  apply_pressure_constraints(constraints_, grid_, t);
+}
+
+/// Phase 2 (saturated): the pore pressure interpolated from the nodes,
+/// p_hat = sum N_j p_j, enters the total stress: f_i += V p_hat grad N_i.
+template <int Dim, class Shape>
+inline void Simulation<Dim, Shape>::map_pore_pressure_force(const Out& out, std::size_t begin,
+                                                            std::size_t end) {
+  StencilT s;
+  for (std::size_t p = begin; p < end; ++p) {
+    if (!constants_[particles_.material[p]].saturated) continue;
+    stencil_in_step<true, true>(p, s);
+    double p_hat = 0.0;
+    for (int k = 0; k < StencilT::N; ++k) p_hat += s.w[k] * grid_.pressure[s.node[k]];
+    const double vp = particles_.volume[p] * p_hat;
+    for (int k = 0; k < StencilT::N; ++k) at<nodal::force>(out)[s.node[k]] += vp * s.grad(k);
+  }
+}
+
+/// Grid: ds p/dt from the scattered flux (forward Euler: dp = dt flux /
+/// storage); free nodes advance, prescribed nodes take their value at t + dt.
+template <int Dim, class Shape>
+inline void Simulation<Dim, Shape>::update_nodal_pressure(double t_new, double dt) {
+  for_nodes([&](std::int64_t b, std::int64_t e) {
+    for (std::int64_t i = b; i < e; ++i)
+      grid_.dp[i] = grid_.storage[i] > 0 ? dt * grid_.flux[i] / grid_.storage[i] : 0.0;
+  });
+  apply_pressure_increment_constraints(constraints_, grid_, t_new);
+}
+
+/// Phase 5 (saturated): particle pressure state += sum N dp_i (FLIP);
+/// reported pressure = sum N p_i^{n+1}; particles move.
+template <int Dim, class Shape>
+inline void Simulation<Dim, Shape>::update_particle_pressure_and_position(std::size_t begin,
+                                                                          std::size_t end,
+                                                                          double dt) {
+  StencilT s;
+  for (std::size_t p = begin; p < end; ++p) {
+    stencil_in_step<false, true>(p, s);
+    if (constants_[particles_.material[p]].saturated) {
+      double dp = 0.0, p_new = 0.0;  // weights only: this pass needs no gradient
+      for (int k = 0; k < StencilT::N; ++k) {
+        const std::int64_t i = s.node[k];
+        dp += s.w[k] * grid_.dp[i];
+        p_new += s.w[k] * (grid_.pressure[i] + grid_.dp[i]);
+      }
+      particles_.pressure[p] += dp;
+      particles_.pressure_out[p] = p_new;
+      if (!std::isfinite(p_new)) fail_nonfinite(p, "pore pressure");
+    }
+    move_particle(p, s, dt);
+  }
+}
+
+}  // namespace hmpm

@@ -1,0 +1,77 @@
+// phases/stress_and_flux.hpp — the strain-rate phase: stress update through
+// the materials' models, volume and porosity, and the fluid flux of the mass
+// balance (internal).
+#pragma once
+
+#include <cstdint>
+
+#include "materials/material.hpp"
+#include "objective_rate.hpp"
+#include "simulation.hpp"
+
+namespace hmpm {
+
+/// Phase 4: strain increment from the re-mapped nodal velocities, stress
+/// update, volume and porosity; the fluid flux of the mass balance,
+/// -N V div v + V grad N . w, is scattered to the nodes (Fluid: runs with
+/// a saturated material). In dry runs (!Fluid) the particles also move
+/// with the Lagrangian nodal velocity; in saturated runs the last phase
+/// moves them. Plastic: some material has a return mapping
+/// (return_to_yield_surface, materials/material.hpp).
+template <int Dim, class Shape>
+template <bool Fluid, bool Plastic>
+inline void Simulation<Dim, Shape>::update_particle_stress_and_fluid_flux(const Out& out,
+                                                                          std::size_t begin,
+                                                                          std::size_t end,
+                                                                          double dt) {
+  StencilT s;
+  for (std::size_t p = begin; p < end; ++p) {
+    stencil_in_step<true, true>(p, s);
+    Mat grad_v = Mat::Zero();
+    for (int k = 0; k < StencilT::N; ++k)
+      grad_v.noalias() += grid_.remap[s.node[k]] * s.grad(k).transpose();
+    const double vol = particles_.volume[p];
+    const std::uint16_t mat = particles_.material[p];
+    const MaterialConstants& mc = constants_[mat];
+    if (Fluid && mc.saturated) {
+      const double div_v = grad_v.trace();
+      Vec grad_p = Vec::Zero(), a = Vec::Zero();
+      for (int k = 0; k < StencilT::N; ++k) {
+        grad_p += grid_.pressure[s.node[k]] * s.grad(k);
+        a += s.w[k] * grid_.accel[s.node[k]];
+      }
+      const Vec w = -mc.permeability_over_gamma *
+                    (grad_p - mc.fluid_density * gravity_ + mc.darcy_inertia_density * a);
+      particles_.darcy[p] = w;
+      for (int k = 0; k < StencilT::N; ++k)
+        at<nodal::flux>(out)[s.node[k]] += vol * (s.grad(k).dot(w) - s.w[k] * div_v);
+    }
+    Voigt de = Voigt::Zero();
+    for (int a = 0; a < Dim; ++a) de[a] = grad_v(a, a) * dt;
+    if constexpr (Dim >= 2) de[3] = 0.5 * (grad_v(0, 1) + grad_v(1, 0)) * dt;
+    if constexpr (Dim == 3) {
+      de[4] = 0.5 * (grad_v(1, 2) + grad_v(2, 1)) * dt;
+      de[5] = 0.5 * (grad_v(2, 0) + grad_v(0, 2)) * dt;
+    }
+    const double tr = de[0] + de[1] + de[2];
+    Voigt& sig = particles_.stress[p];
+    if constexpr (Dim >= 2) rotate_jaumann<Dim>(sig, grad_v, dt);
+    // Constants copied first: the stores to sig could alias mc for the compiler.
+    const double lambda_tr = mc.lambda * tr, two_g = 2.0 * mc.shear_modulus;
+    // Below 3D the shear increments yz and zx (in 1D also xy) are zero:
+    // the loops end before them (components 0..kEnd-1 can change).
+    constexpr int kEnd = Dim == 1 ? 3 : (Dim == 2 ? 4 : 6);
+    for (int c = 0; c < 3; ++c) sig[c] += lambda_tr + two_g * de[c];
+    for (int c = 3; c < kEnd; ++c) sig[c] += two_g * de[c];
+    if constexpr (Plastic) return_to_yield_surface(sig, mc, {particles_.internal.data(), p});
+    for (int c = 0; c < kEnd; ++c) particles_.strain[p][c] += de[c];
+    const Mat f = Mat::Identity() + dt * grad_v;  // a plain matrix: its determinant inlines
+    const double j = f.determinant();
+    if (!(j > 0.0)) fail_volume(p, j);
+    particles_.volume[p] = vol * j;
+    if (Fluid && mc.saturated) particles_.porosity[p] = 1.0 - (1.0 - particles_.porosity[p]) / j;
+    if constexpr (!Fluid) move_particle(p, s, dt);
+  }
+}
+
+}  // namespace hmpm

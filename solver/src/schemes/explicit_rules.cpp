@@ -1,0 +1,87 @@
+// schemes/explicit_rules.cpp — the explicit scheme's stable-step rule and
+// its check of a user dt (the problem-level half of explicit_scheme.hpp).
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "format.hpp"
+#include "hmpm/problem.hpp"
+#include "hmpm/run.hpp"
+#include "materials/material.hpp"
+#include "particle_layout.hpp"
+#include "schemes/time_scheme.hpp"
+
+namespace hmpm {
+
+namespace {
+
+/// Per material: some body of it has particles. Only those limit the step
+/// (a material no body uses has no wave and no diffusion). When none has
+/// (a Problem check_problem refuses anyway), every material counts.
+std::vector<bool> materials_with_particles(const Problem& problem) {
+  std::vector<bool> used(problem.materials.size(), false);
+  bool any = false;
+  for (const Body& body : problem.bodies) {
+    if (body.material < 0 || body.material >= static_cast<int>(used.size())) continue;
+    if (body.particles_per_cell < 1 || body_layout(problem, body).count == 0) continue;
+    used[static_cast<std::size_t>(body.material)] = true;
+    any = true;
+  }
+  if (!any) used.assign(used.size(), true);
+  return used;
+}
+
+/// The explicit limits over the materials that have particles.
+StableStep explicit_stable_step(const Problem& problem) {
+  StableStep s;
+  const double h = min_cell_size(problem);
+  const double d = problem.dimension;
+  s.mechanical = std::numeric_limits<double>::infinity();
+  s.hydraulic = std::numeric_limits<double>::infinity();
+  const std::vector<bool> with_particles = materials_with_particles(problem);
+  for (std::size_t i = 0; i < problem.materials.size(); ++i) {
+    if (!with_particles[i]) continue;
+    const Material& m = problem.materials[i];
+    const MaterialConstants mc = material_constants(m, problem.gravity_constant);
+    const double c = std::sqrt(mc.undrained_p_modulus / mc.mixture_density);
+    s.wave_speed = std::max(s.wave_speed, c);
+    // Explicit central differences with lumped mass: omega_max <= sqrt(d) 2c/h,
+    // stable for dt <= 2/omega_max = h / (c sqrt(d)).
+    s.mechanical = std::min(s.mechanical, h / (c * std::sqrt(d)));
+    if (m.hydraulic) {
+      // Forward Euler on dp/dt = c_h lap p with lumped storage:
+      // lambda_max = 4 d c_h / h^2, stable for dt <= 2/lambda_max.
+      const double c_h = mc.permeability_over_gamma / mc.storage;
+      s.hydraulic = std::min(s.hydraulic, h * h / (2.0 * d * c_h));
+    }
+  }
+  s.limit = std::min(s.mechanical, s.hydraulic);
+  s.chosen = problem.time.dt ? *problem.time.dt : problem.time.courant * s.limit;
+  return s;
+}
+
+/// A user dt above the explicit limit cannot run.
+void check_explicit_step(const Problem& problem, const StableStep& s,
+                         std::vector<ProblemIssue>& issues) {
+  if (!problem.time.dt || *problem.time.dt <= s.limit * (1.0 + 1e-12)) return;
+  auto fmt = [](double v) { return format_number(v, 4); };
+  std::string why = s.hydraulic < s.mechanical
+                        ? "the explicit hydraulic diffusion limit h^2/(2 d k/(gamma_w Q))"
+                        : "the mechanical limit h/(c sqrt(d)) with undrained wave speed c = " +
+                              fmt(s.wave_speed) + " m/s";
+  issues.push_back({"time/dt", "is " + fmt(*problem.time.dt) + " s, above the stable limit " +
+                                   fmt(s.limit) + " s (" + why + "); use dt <= " + fmt(s.limit) +
+                                   " or omit dt to let the solver choose " + fmt(0.5 * s.limit) +
+                                   " s"});
+}
+
+}  // namespace
+
+const SchemeRules& explicit_scheme_rules() {
+  static const SchemeRules rules{"explicit", explicit_stable_step, check_explicit_step};
+  return rules;
+}
+
+}  // namespace hmpm

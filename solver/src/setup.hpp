@@ -1,0 +1,181 @@
+// setup.hpp — building a Simulation from a Problem (internal; included by
+// the simulation_{1,2,3}d.cpp instantiations): the grid, the material
+// constants, the particles, the compiled constraints and loads, and the
+// geostatic initial state. Runs once per run; allocates, never per step.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <type_traits>
+#include <vector>
+
+#include "boundary/constraints.hpp"
+#include "boundary/tractions.hpp"
+#include "geostatic.hpp"
+#include "particle_layout.hpp"
+#include "simulation.hpp"
+
+namespace hmpm {
+
+template <int Dim, class Shape>
+Simulation<Dim, Shape>::Simulation(const Problem& problem) : problem_(problem) {
+  setup_grid();
+  setup_materials();
+  setup_particles();
+  constraints_ = compile_constraints<Dim>(problem_, grid_, grid_max_, fluid_);
+  tractions_ = compile_tractions<Dim>(problem_, particles_, grid_);
+  setup_geostatic();
+}
+
+template <int Dim, class Shape>
+void Simulation<Dim, Shape>::setup_grid() {
+  for (int a = 0; a < Dim; ++a) {
+    grid_.cells[a] = problem_.grid.cells[a];
+    grid_.origin[a] = problem_.grid.min[a];
+    grid_.h[a] = (problem_.grid.max[a] - problem_.grid.min[a]) / grid_.cells[a];
+    grid_.inv_h[a] = 1.0 / grid_.h[a];
+  }
+  for (int a = 0; a < Dim; ++a) grid_max_[a] = problem_.grid.max[a];
+  grid_.count = 1;
+  for (int a = 0; a < Dim; ++a) {
+    grid_.stride[a] = grid_.count;
+    grid_.count *= grid_.cells[a] + 1;
+  }
+}
+
+template <int Dim, class Shape>
+void Simulation<Dim, Shape>::setup_materials() {
+  for (const Material& m : problem_.materials) {
+    constants_.push_back(material_constants(m, problem_.gravity_constant));
+    const Hydraulic h = m.hydraulic.value_or(Hydraulic{});
+    inv_ks_.push_back(std::isinf(h.solid_bulk_modulus) ? 0.0 : 1.0 / h.solid_bulk_modulus);
+    inv_kf_.push_back(1.0 / h.fluid_bulk_modulus);
+    fluid_ = fluid_ || m.hydraulic.has_value();
+    plastic_ = plastic_ || constants_.back().model != Model::linear_elastic;
+  }
+  for (const Body& body : problem_.bodies)
+    state_variables_ =
+        std::max(state_variables_,
+                 state_variable_count(constants_[static_cast<std::size_t>(body.material)].model));
+  for (const ProblemIssue& w : problem_warnings(problem_))
+    warnings_.push_back(w.where + ": " + w.message);
+  for (int a = 0; a < Dim; ++a) gravity_[a] = problem_.gravity[a];
+}
+
+template <int Dim, class Shape>
+void Simulation<Dim, Shape>::setup_particles() {
+  const bool gimp = std::is_same_v<Shape, shape::Gimp>;
+  particles_.resize(static_cast<std::size_t>(count_particles(problem_)), fluid_, gimp,
+                    state_variables_);
+  grid_.resize(fluid_);
+  std::size_t p = 0;
+  double cell_volume = 1.0;
+  for (int a = 0; a < Dim; ++a) cell_volume *= grid_.h[a];
+  for (const Body& body : problem_.bodies) {
+    const BodyLayout layout = body_layout(problem_, body);
+    const MaterialConstants& mc = constants_[static_cast<std::size_t>(body.material)];
+    const int ppc = body.particles_per_cell;
+    const double v0 = cell_volume / std::pow(ppc, Dim);
+    for (double z : layout.coords[2])
+      for (double y : layout.coords[1])
+        for (double x : layout.coords[0]) {
+          const Vec3 x3{x, y, z};
+          for (int a = 0; a < Dim; ++a) particles_.x[p][a] = x3[a];
+          particles_.x0[p] = particles_.x[p];
+          particles_.volume[p] = v0;
+          particles_.mass[p] = mc.mixture_density * v0;
+          particles_.material[p] = static_cast<std::uint16_t>(body.material);
+          if (gimp) particles_.half_length[p] = 0.5 / ppc;
+          const InitialFields& init = body.initial;
+          for (int a = 0; a < Dim; ++a)
+            if (init.velocity[a]) particles_.v[p][a] = init.velocity[a](x3);
+          for (int c = 0; c < 6; ++c)
+            if (init.effective_stress[c]) particles_.stress[p][c] = init.effective_stress[c](x3);
+          if (fluid_ && mc.saturated) {
+            const double p0 = init.pore_pressure ? init.pore_pressure(x3) : 0.0;
+            particles_.pressure[p] = p0;
+            particles_.pressure_out[p] = p0;
+            particles_.porosity[p] = mc.porosity;
+          }
+          ++p;
+        }
+  }
+}
+
+/// Geostatic initial state (Problem::initial_state.geostatic): effective
+/// stress and pore pressure from the layered closed form at every particle.
+/// The reported pressure is the closed form; the transported pressure state
+/// is then corrected so that the nodal pressure the first step computes
+/// from it (a storage-weighted average, biased by a fraction of a cell at
+/// boundary nodes where particles lie on one side only) is the hydrostatic
+/// nodal field itself. Its interpolation then gives back the closed form at
+/// every particle, so pressure, effective stress and weight balance at
+/// every node and the ground stays at rest.
+template <int Dim, class Shape>
+void Simulation<Dim, Shape>::setup_geostatic() {
+  if (!problem_.initial_state.geostatic) return;
+  const GeostaticState g = geostatic_state(problem_);
+  for (std::size_t p = 0; p < particles_.size(); ++p) {
+    geostatic_voigt(g, p, particles_.stress[p].data());
+    if (fluid_ && constants_[particles_.material[p]].saturated) {
+      particles_.pressure[p] = g.pressure[p];
+      particles_.pressure_out[p] = g.pressure[p];
+    }
+  }
+  if (fluid_) balance_initial_pressure_state();
+}
+
+/// Richardson iteration on the particle pressure state s until the nodal
+/// pressure mapped from it interpolates back to the reported pressure at
+/// every saturated particle: s += p_out - N W s (N W is similar to a
+/// symmetric matrix with eigenvalues in [0, 1], so it converges wherever
+/// the target is an interpolated nodal field; about 100 sweeps to
+/// round-off, independent of the grid size). Set-up only.
+template <int Dim, class Shape>
+void Simulation<Dim, Shape>::balance_initial_pressure_state() {
+  double scale = 0.0;
+  for (double v : particles_.pressure_out) scale = std::max(scale, std::abs(v));
+  if (scale == 0.0) return;
+  StencilT s;
+  double checkpoint = std::numeric_limits<double>::infinity();
+  for (int iteration = 0; iteration < 500; ++iteration) {
+    std::fill(grid_.storage.begin(), grid_.storage.end(), 0.0);
+    std::fill(grid_.pressure.begin(), grid_.pressure.end(), 0.0);
+    for (std::size_t p = 0; p < particles_.size(); ++p) {
+      const std::uint16_t mat = particles_.material[p];
+      if (!constants_[mat].saturated) continue;
+      stencil_of<false>(p, s);
+      const double n = particles_.porosity[p];
+      const double qv = ((1.0 - n) * inv_ks_[mat] + n * inv_kf_[mat]) * particles_.volume[p];
+      for (int k = 0; k < StencilT::N; ++k) {
+        grid_.storage[s.node[k]] += s.w[k] * qv;
+        grid_.pressure[s.node[k]] += s.w[k] * qv * particles_.pressure[p];
+      }
+    }
+    compute_nodal_pressure(0.0);
+    double residual = 0.0;
+    for (std::size_t p = 0; p < particles_.size(); ++p) {
+      if (!constants_[particles_.material[p]].saturated) continue;
+      stencil_of<false>(p, s);
+      double p_hat = 0.0;
+      for (int k = 0; k < StencilT::N; ++k) p_hat += s.w[k] * grid_.pressure[s.node[k]];
+      const double r = particles_.pressure_out[p] - p_hat;
+      particles_.pressure[p] += r;
+      residual = std::max(residual, std::abs(r));
+    }
+    if (residual <= 1e-15 * scale) break;
+    // Where the target is not an interpolated nodal field (B-splines next
+    // to the clamped boundary) the residual stalls: stop when 50 sweeps
+    // have not halved it.
+    if (iteration % 50 == 0) {
+      if (residual > 0.5 * checkpoint) break;
+      checkpoint = residual;
+    }
+  }
+  std::fill(grid_.storage.begin(), grid_.storage.end(), 0.0);
+  std::fill(grid_.pressure.begin(), grid_.pressure.end(), 0.0);
+}
+
+}  // namespace hmpm

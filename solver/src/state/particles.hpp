@@ -1,0 +1,86 @@
+// state/particles.hpp — the particle state as a structure of arrays (internal).
+//
+// Particles carry everything that survives a step (the grid, state/grid.hpp,
+// is scratch space cleared every step). Fixed-size Eigen types, one
+// std::vector per field, all sized once at set-up: nothing here allocates
+// during the time loop. Arrays of the fluid phase are empty when no material
+// is saturated; the internal state variables of the soil models
+// (materials/material.hpp) are one array per variable, none when no model
+// of the run declares any.
+#pragma once
+
+#include <Eigen/Core>
+#include <array>
+#include <cstdint>
+#include <vector>
+
+namespace hmpm {
+
+template <int Dim>
+using VecD = Eigen::Matrix<double, Dim, 1>;
+/// Symmetric tensor in Voigt order xx, yy, zz, xy, yz, zx (tensor components,
+/// not engineering shear strains).
+using Voigt = Eigen::Matrix<double, 6, 1>;
+
+template <int Dim>
+struct ParticleState {
+  using Vec = VecD<Dim>;
+  std::vector<Vec> x;   ///< position, m
+  std::vector<Vec> x0;  ///< initial position, m (displacement = x - x0; not touched by the step)
+  std::vector<Vec> v;   ///< velocity, m/s
+  std::vector<double> mass;    ///< kg (per unit area in 1D, per unit thickness in 2D); constant
+  std::vector<double> volume;  ///< current volume, m^3 (per unit area / thickness)
+  std::vector<Voigt> stress;   ///< effective stress sigma', Pa, compression negative
+  std::vector<Voigt> strain;   ///< small-strain accumulation, tensor components
+  std::vector<std::uint16_t> material;
+  /// Per axis, the cell the particle's stencil is anchored to (Shape::locate),
+  /// set by the step's first phase and reused by the later ones of the same
+  /// step (particles move in the last).
+  std::vector<std::array<std::int32_t, Dim>> cell;
+  std::vector<double> half_length;  ///< GIMP particle half-length in cell units; empty otherwise
+
+  // Fluid phase (empty when dry).
+  std::vector<double> pressure;      ///< transported pore pressure state, Pa (FLIP increments)
+  std::vector<double> pressure_out;  ///< pore pressure interpolated from the nodal field, Pa
+  std::vector<double> porosity;      ///< n
+  std::vector<Vec> darcy;            ///< Darcy velocity w, m/s
+
+  /// Internal state variables of the soil models: internal[k][p] is
+  /// variable k of particle p (its meaning is the particle's model's).
+  /// As many arrays as the most any model with particles declares.
+  std::vector<std::vector<double>> internal;
+
+  std::size_t size() const { return x.size(); }
+
+  void resize(std::size_t n, bool fluid, bool gimp, int state_variables = 0) {
+    internal.assign(static_cast<std::size_t>(state_variables), std::vector<double>(n, 0.0));
+    x.resize(n);
+    x0.resize(n);
+    v.assign(n, Vec::Zero());
+    mass.resize(n);
+    volume.resize(n);
+    stress.assign(n, Voigt::Zero());
+    strain.assign(n, Voigt::Zero());
+    material.resize(n);
+    cell.resize(n);
+    if (gimp) half_length.resize(n);
+    if (fluid) {
+      pressure.assign(n, 0.0);
+      pressure_out.assign(n, 0.0);
+      porosity.assign(n, 0.0);
+      darcy.assign(n, Vec::Zero());
+    }
+  }
+
+  std::int64_t bytes() const {
+    const std::size_t n = size();
+    std::size_t per = sizeof(Vec) * 3 + sizeof(double) * 2 + sizeof(Voigt) * 2 +
+                      sizeof(std::uint16_t) + sizeof(std::array<std::int32_t, Dim>);
+    if (!half_length.empty()) per += sizeof(double);
+    if (!pressure.empty()) per += sizeof(double) * 3 + sizeof(Vec);
+    per += sizeof(double) * internal.size();
+    return static_cast<std::int64_t>(n * per);
+  }
+};
+
+}  // namespace hmpm
