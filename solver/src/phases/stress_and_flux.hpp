@@ -65,7 +65,13 @@ inline void Simulation<Dim, Shape>::update_particle_stress_and_fluid_flux(const 
     for (int c = 3; c < kEnd; ++c) sig[c] += two_g * de[c];
     if constexpr (Plastic) return_to_yield_surface(sig, mc, {particles_.internal.data(), p});
     for (int c = 0; c < kEnd; ++c) particles_.strain[p][c] += de[c];
-    const Mat f = Mat::Identity() + dt * grad_v;  // a plain matrix: its determinant inlines
+    // F = I + dt grad v, a plain matrix (its determinant inlines), filled
+    // element by element: Eigen's assignment loop may be left out of line in
+    // a translation unit whose inlining budget is spent, which changes the
+    // rounding (FMA contraction) of the determinant.
+    Mat f;
+    for (int a = 0; a < Dim; ++a)
+      for (int b = 0; b < Dim; ++b) f(a, b) = (a == b ? 1.0 : 0.0) + dt * grad_v(a, b);
     const double j = f.determinant();
     if (!(j > 0.0)) fail_volume(p, j);
     particles_.volume[p] = vol * j;
