@@ -1,5 +1,5 @@
 // bench_mpm — throughput of the solver on the performance problem of
-// ../shared/verification/README.md §8: a square elastic block of NB x NB
+// docs/reference-problems.md §8: a square elastic block of NB x NB
 // cells (h = 0.01 m, 2x2 particles per cell) in a grid NB wide and NB + 2
 // high, E = 1 MPa, nu = 0.3, rho = 1800, gravity -9.81, bottom fixed, sides
 // on rollers, dt = 1e-4 s. `--coupled` makes it saturated (u-p), `--dim 3`
@@ -38,18 +38,27 @@ int main(int argc, char** argv) {
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     auto next = [&]() { return i + 1 < argc ? argv[++i] : ""; };
-    if (a == "--dim") dim = std::atoi(next());
-    else if (a == "--nb") nb = std::atoi(next());
-    else if (a == "--steps") steps = std::atoi(next());
-    else if (a == "--threads") threads = std::atoi(next());
-    else if (a == "--ppc") ppc = std::atoi(next());
-    else if (a == "--coupled") coupled = true;
+    if (a == "--dim")
+      dim = std::atoi(next());
+    else if (a == "--nb")
+      nb = std::atoi(next());
+    else if (a == "--steps")
+      steps = std::atoi(next());
+    else if (a == "--threads")
+      threads = std::atoi(next());
+    else if (a == "--ppc")
+      ppc = std::atoi(next());
+    else if (a == "--coupled")
+      coupled = true;
     else if (a == "--shape") {
       const std::string s = next();
-      shape = s == "gimp" ? hmpm::ShapeFunction::gimp
-                          : (s == "bspline" ? hmpm::ShapeFunction::bspline : hmpm::ShapeFunction::linear);
+      shape = s == "gimp"
+                  ? hmpm::ShapeFunction::gimp
+                  : (s == "bspline" ? hmpm::ShapeFunction::bspline : hmpm::ShapeFunction::linear);
     } else {
-      std::fprintf(stderr, "usage: bench_mpm [--dim 2|3] [--nb N] [--steps S] [--threads T] [--ppc P] [--coupled] [--shape linear|gimp|bspline]\n");
+      std::fprintf(stderr,
+                   "usage: bench_mpm [--dim 2|3] [--nb N] [--steps S] [--threads T] [--ppc P] "
+                   "[--coupled] [--shape linear|gimp|bspline]\n");
       return 2;
     }
   }
@@ -104,13 +113,17 @@ int main(int argc, char** argv) {
     return 1;
   }
   const long rss = peak_rss_bytes();
-  std::printf("dim=%d nb=%d coupled=%d shape=%s threads=%d particles=%lld nodes=%lld steps=%lld "
-              "particle_steps_per_second=%.4g state_bytes_per_particle=%.1f peak_rss_bytes_per_particle=%.1f\n",
-              dim, nb, coupled ? 1 : 0,
-              shape == hmpm::ShapeFunction::linear ? "linear" : (shape == hmpm::ShapeFunction::gimp ? "gimp" : "bspline"),
-              r.threads, static_cast<long long>(r.particles), static_cast<long long>(r.nodes),
-              static_cast<long long>(r.steps), r.particle_steps_per_second,
-              static_cast<double>(r.state_bytes) / static_cast<double>(r.particles),
-              static_cast<double>(rss) / static_cast<double>(r.particles));
+  std::printf(
+      "dim=%d nb=%d coupled=%d shape=%s threads=%d particles=%lld nodes=%lld steps=%lld "
+      "particle_steps_per_second=%.4g state_bytes_per_particle=%.1f "
+      "peak_rss_bytes_per_particle=%.1f\n",
+      dim, nb, coupled ? 1 : 0,
+      shape == hmpm::ShapeFunction::linear
+          ? "linear"
+          : (shape == hmpm::ShapeFunction::gimp ? "gimp" : "bspline"),
+      r.threads, static_cast<long long>(r.particles), static_cast<long long>(r.nodes),
+      static_cast<long long>(r.steps), r.particle_steps_per_second,
+      static_cast<double>(r.state_bytes) / static_cast<double>(r.particles),
+      static_cast<double>(rss) / static_cast<double>(r.particles));
   return 0;
 }

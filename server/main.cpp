@@ -13,20 +13,23 @@
 #include <iostream>
 #include <thread>
 
+#include "hmpm/api/exit_codes.hpp"
 #include "hmpm/server/options.hpp"
 #include "hmpm/server/service.hpp"
 #include "hmpm/server/store.hpp"
 
 int main(int argc, char** argv) {
+  using hmpm::api::exit_status;
+  using hmpm::api::ExitCode;
   const std::vector<std::string> args(argv + 1, argv + argc);
   const auto parsed = hmpm::server::parse_options(args, std::getenv("HMPM_TOKEN"));
   if (parsed.help) {
     std::cout << hmpm::server::usage();
-    return 0;
+    return exit_status(ExitCode::ok);
   }
   if (!parsed.config) {
     std::cerr << "hmpm-server: " << parsed.error << "\n" << hmpm::server::usage();
-    return 2;
+    return exit_status(ExitCode::server_usage);
   }
 
   // Block the stop signals before any thread exists, so all threads inherit
@@ -44,7 +47,7 @@ int main(int argc, char** argv) {
     if (port < 0) {
       std::cerr << "hmpm-server: cannot listen on " << parsed.config->host << ":"
                 << parsed.config->port << "\n";
-      return 1;
+      return exit_status(ExitCode::failure);
     }
     std::thread signal_thread([&service, stop_signals] {
       int signal_number = 0;
@@ -53,12 +56,12 @@ int main(int argc, char** argv) {
     });
     signal_thread.detach();  // still waiting if run() ends by itself; exit ends it
     std::cout << "listening on http://" << parsed.config->host << ":" << port << std::endl;
-    return service.run() ? 0 : 1;
+    return exit_status(service.run() ? ExitCode::ok : ExitCode::failure);
   } catch (const hmpm::server::StoreFailure& e) {
     std::cerr << "hmpm-server: " << e.what() << "\n";
-    return 1;
+    return exit_status(ExitCode::failure);
   } catch (const std::exception& e) {
     std::cerr << "hmpm-server: " << e.what() << "\n";
-    return 1;
+    return exit_status(ExitCode::failure);
   }
 }

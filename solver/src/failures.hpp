@@ -8,7 +8,7 @@
 #include <string>
 #include <utility>
 
-#include "format.hpp"
+#include "hmpm/format.hpp"
 #include "simulation.hpp"
 
 namespace hmpm {
@@ -66,7 +66,7 @@ void Simulation<Dim, Shape>::fail_volume(std::size_t p, double j) {
 
 template <int Dim, class Shape>
 std::string Simulation<Dim, Shape>::number(double v) {
-  return format_number(v, 6);
+  return format_significant(v, 6);
 }
 
 }  // namespace hmpm

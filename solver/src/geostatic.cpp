@@ -5,7 +5,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "format.hpp"
+#include "hmpm/format.hpp"
 #include "materials/material.hpp"
 #include "particle_layout.hpp"
 
@@ -88,7 +88,9 @@ double surface_at(const std::vector<BodyExtent>& extents, const Vec3& x, const V
   return top;
 }
 
-std::string fmt(double x) { return format_number(x, 6); }
+std::string fmt(double x) {
+  return format_significant(x, 6);
+}
 
 }  // namespace
 

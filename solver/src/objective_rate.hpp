@@ -19,9 +19,8 @@ namespace hmpm {
 /// memory at every particle (callgrind, 3D dry: 1328 -> 1294 instructions per
 /// particle-step).
 template <int Dim>
-__attribute__((always_inline)) inline void rotate_jaumann(Eigen::Matrix<double, 6, 1>& s,
-                                                          const Eigen::Matrix<double, Dim, Dim>& grad_v,
-                                                          double dt) {
+__attribute__((always_inline)) inline void rotate_jaumann(
+    Eigen::Matrix<double, 6, 1>& s, const Eigen::Matrix<double, Dim, Dim>& grad_v, double dt) {
   if constexpr (Dim == 2) {
     const double a = 0.5 * (grad_v(0, 1) - grad_v(1, 0)) * dt;  // W_xy dt
     const double dxx = 2.0 * a * s[3], dxy = a * (s[1] - s[0]);

@@ -47,7 +47,9 @@ class ThreadPool {
   int size() const { return size_; }
 
   /// Chunk t of [0, n) for `size()` threads.
-  std::size_t chunk_begin(std::size_t n, int t) const { return n * static_cast<std::size_t>(t) / size_; }
+  std::size_t chunk_begin(std::size_t n, int t) const {
+    return n * static_cast<std::size_t>(t) / size_;
+  }
 
   /// Runs f(thread, begin, end) on every chunk of [0, n); returns when all are done.
   template <class F>

@@ -7,8 +7,8 @@
 #include <limits>
 #include <stdexcept>
 
-#include "format.hpp"
 #include "geostatic.hpp"
+#include "hmpm/format.hpp"
 #include "hmpm/problem.hpp"
 #include "hmpm/run.hpp"
 #include "materials/material.hpp"
@@ -19,9 +19,12 @@ namespace hmpm {
 
 const char* status_name(RunStatus s) {
   switch (s) {
-    case RunStatus::successful: return "successful";
-    case RunStatus::failed: return "failed";
-    case RunStatus::cancelled: return "dismissed";
+    case RunStatus::successful:
+      return "successful";
+    case RunStatus::failed:
+      return "failed";
+    case RunStatus::cancelled:
+      return "dismissed";
   }
   return "failed";
 }
@@ -79,8 +82,8 @@ std::int64_t nearest_particle(const Problem& problem, const Vec3& x) {
     for (double pz : layout.coords[2])
       for (double py : layout.coords[1])
         for (double px : layout.coords[0]) {
-          const double d2 = (px - x[0]) * (px - x[0]) + (py - x[1]) * (py - x[1]) +
-                            (pz - x[2]) * (pz - x[2]);
+          const double d2 =
+              (px - x[0]) * (px - x[0]) + (py - x[1]) * (py - x[1]) + (pz - x[2]) * (pz - x[2]);
           if (d2 < best_d2) {
             best_d2 = d2;
             best = index;
@@ -100,13 +103,17 @@ double min_cell_size(const Problem& problem) {
   return h;
 }
 
-StableStep stable_step(const Problem& problem) { return scheme_rules(problem).stable_step(problem); }
+StableStep stable_step(const Problem& problem) {
+  return scheme_rules(problem).stable_step(problem);
+}
 
 // ---------------------------------------------------------------- checks
 
 namespace {
 
-std::string fmt(double v) { return format_number(v, 4); }
+std::string fmt(double v) {
+  return format_significant(v, 4);
+}
 
 }  // namespace
 
@@ -149,8 +156,7 @@ std::vector<ProblemIssue> check_problem(const Problem& problem) {
     return issues;
   }
   for (int a = 0; a < dim; ++a) {
-    if (problem.grid.cells[a] < 1)
-      add("grid/cells/" + std::to_string(a), "must be >= 1");
+    if (problem.grid.cells[a] < 1) add("grid/cells/" + std::to_string(a), "must be >= 1");
     if (!(problem.grid.max[a] > problem.grid.min[a]))
       add("grid/max/" + std::to_string(a), "must be greater than grid.min");
   }
@@ -179,10 +185,12 @@ std::vector<ProblemIssue> check_problem(const Problem& problem) {
     const std::string w = "bodies/" + std::to_string(b) + "/";
     if (body.material < 0 || body.material >= static_cast<int>(problem.materials.size()))
       add(w + "material", "names no material");
-    if (body.particles_per_cell < 1) add(w + "particles_per_cell", "must be >= 1");
+    if (body.particles_per_cell < 1)
+      add(w + "particles_per_cell", "must be >= 1");
     else if (body_layout(problem, body).count == 0)
-      add(w + "box", "contains no whole grid cell, so no particles; a body fills the cells "
-                     "that lie entirely inside its box");
+      add(w + "box",
+          "contains no whole grid cell, so no particles; a body fills the cells "
+          "that lie entirely inside its box");
   }
   for (std::size_t i = 0; i < problem.boundaries.size(); ++i) {
     const Boundary& bc = problem.boundaries[i];
@@ -200,7 +208,8 @@ std::vector<ProblemIssue> check_problem(const Problem& problem) {
     if (!(*bc.friction >= 0)) add(w, "must be >= 0");
   }
   if (!(problem.time.end > 0)) add("time/end", "must be > 0");
-  if (!(problem.time.courant > 0 && problem.time.courant <= 1)) add("time/courant", "must be in (0, 1]");
+  if (!(problem.time.courant > 0 && problem.time.courant <= 1))
+    add("time/courant", "must be in (0, 1]");
   if (problem.time.dt && !(*problem.time.dt > 0)) add("time/dt", "must be > 0");
   if (!issues.empty()) return issues;
 

@@ -69,8 +69,8 @@ struct Gimp {
   static inline int locate(double xi, int cells) {
     return std::clamp(static_cast<int>(xi + 0.5) - 1, 0, cells - 2);  // xi >= 0 inside the grid
   }
-  static inline void eval(double xi, int b, int /*cells*/, double half_length, int& base,
-                          double* w, double* dw) {
+  static inline void eval(double xi, int b, int /*cells*/, double half_length, int& base, double* w,
+                          double* dw) {
     base = b;
     for (int k = 0; k < 3; ++k) weight(xi - (b + k), half_length, w[k], dw[k]);
   }
@@ -81,25 +81,39 @@ struct BSpline {
   static constexpr int K = 3;
   /// The cell of the middle node's left neighbour; -1 or cells - 1 next to
   /// the boundary, where eval folds the ghost node in.
-  static inline int locate(double xi, int /*cells*/) { return static_cast<int>(std::floor(xi - 0.5)); }
-  static inline void eval(double xi, int b, int cells, double /*half_length*/, int& base,
-                          double* w, double* dw) {
+  static inline int locate(double xi, int /*cells*/) {
+    return static_cast<int>(std::floor(xi - 0.5));
+  }
+  static inline void eval(double xi, int b, int cells, double /*half_length*/, int& base, double* w,
+                          double* dw) {
     const double f = xi - b;  // in [0.5, 1.5)
     double w0 = 0.5 * (1.5 - f) * (1.5 - f), w1 = 0.75 - (f - 1.0) * (f - 1.0),
            w2 = 0.5 * (f - 0.5) * (f - 0.5);
     double d0 = -(1.5 - f), d1 = -2.0 * (f - 1.0), d2 = f - 0.5;
     if (b < 0) {  // ghost node -1 folded into node 0
       base = 0;
-      w[0] = w0 + w1; w[1] = w2; w[2] = 0.0;
-      dw[0] = d0 + d1; dw[1] = d2; dw[2] = 0.0;
+      w[0] = w0 + w1;
+      w[1] = w2;
+      w[2] = 0.0;
+      dw[0] = d0 + d1;
+      dw[1] = d2;
+      dw[2] = 0.0;
     } else if (b + 2 > cells) {  // ghost node cells+1 folded into node cells
       base = cells - 2;
-      w[0] = 0.0; w[1] = w0; w[2] = w1 + w2;
-      dw[0] = 0.0; dw[1] = d0; dw[2] = d1 + d2;
+      w[0] = 0.0;
+      w[1] = w0;
+      w[2] = w1 + w2;
+      dw[0] = 0.0;
+      dw[1] = d0;
+      dw[2] = d1 + d2;
     } else {
       base = b;
-      w[0] = w0; w[1] = w1; w[2] = w2;
-      dw[0] = d0; dw[1] = d1; dw[2] = d2;
+      w[0] = w0;
+      w[1] = w1;
+      w[2] = w2;
+      dw[0] = d0;
+      dw[1] = d1;
+      dw[2] = d2;
     }
   }
 };

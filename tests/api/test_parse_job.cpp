@@ -57,7 +57,7 @@ TEST(ParseJob, RoundTripOfEveryField) {
   EXPECT_DOUBLE_EQ(sand.hydraulic->fluid_bulk_modulus, 2.2e9);
   EXPECT_DOUBLE_EQ(sand.hydraulic->fluid_density, 1000);        // default
   EXPECT_TRUE(std::isinf(sand.hydraulic->solid_bulk_modulus));  // default: incompressible grains
-  EXPECT_TRUE(sand.hydraulic->darcy_inertia);                    // default: the paper's model
+  EXPECT_TRUE(sand.hydraulic->darcy_inertia);                   // default: the paper's model
   EXPECT_TRUE(std::holds_alternative<LinearElastic>(other.plasticity));
   EXPECT_FALSE(other.hydraulic.has_value());
 

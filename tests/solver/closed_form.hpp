@@ -1,5 +1,5 @@
 // closed_form.hpp — analytical solutions of the reference problems
-// (../shared/verification/README.md), used as the yardstick of the tests.
+// (docs/reference-problems.md), used as the yardstick of the tests.
 #pragma once
 
 #include <cmath>
@@ -14,8 +14,12 @@ struct Bar {
   double E, rho, L, v0;
   double beta() const { return pi / (2 * L); }
   double omega() const { return beta() * std::sqrt(E / rho); }
-  double displacement(double x, double t) const { return v0 / omega() * std::sin(omega() * t) * std::sin(beta() * x); }
-  double velocity(double x, double t) const { return v0 * std::cos(omega() * t) * std::sin(beta() * x); }
+  double displacement(double x, double t) const {
+    return v0 / omega() * std::sin(omega() * t) * std::sin(beta() * x);
+  }
+  double velocity(double x, double t) const {
+    return v0 * std::cos(omega() * t) * std::sin(beta() * x);
+  }
 };
 
 /// Transient pressure in a column with p = dp at x = 0 and 0 at x = L (§2).

@@ -58,7 +58,8 @@ Measured run_bar(const BarCase& c, std::optional<double> dt, int spare_cells = 0
   p.output.series_particles = {0, 3, 6, last};
   p.output.series_fields = {hmpm::Field::displacement};
   p.output.snapshot_interval = p.time.end / 200;
-  p.output.snapshot_fields = {hmpm::Field::velocity, hmpm::Field::effective_stress, hmpm::Field::strain};
+  p.output.snapshot_fields = {hmpm::Field::velocity, hmpm::Field::effective_stress,
+                              hmpm::Field::strain};
   std::vector<double> energy;
   hmpm::RunOptions opt;
   opt.on_snapshot = [&](const hmpm::Snapshot& s) {
@@ -67,7 +68,8 @@ Measured run_bar(const BarCase& c, std::optional<double> dt, int spare_cells = 0
       const double v = s.velocity[3 * i];
       e += 0.5 * s.mass[i] * v * v;
       double se = 0;  // sigma : eps, Voigt tensor components (shear counted twice)
-      for (int k = 0; k < 6; ++k) se += (k < 3 ? 1.0 : 2.0) * s.effective_stress[6 * i + k] * s.strain[6 * i + k];
+      for (int k = 0; k < 6; ++k)
+        se += (k < 3 ? 1.0 : 2.0) * s.effective_stress[6 * i + k] * s.strain[6 * i + k];
       e += 0.5 * s.volume[i] * se;
     }
     energy.push_back(e);

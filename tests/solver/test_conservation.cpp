@@ -26,7 +26,8 @@ hmpm::Material elastic(double rho, double E, double nu) {
 // gradients of a partition of unity sum to zero), so the FLIP update keeps the
 // total momentum to round-off: asserted at 1e-12 of the momentum scale.
 TEST(Conservation, FreeBodyMomentumAndMass) {
-  for (auto shape : {hmpm::ShapeFunction::linear, hmpm::ShapeFunction::gimp, hmpm::ShapeFunction::bspline}) {
+  for (auto shape :
+       {hmpm::ShapeFunction::linear, hmpm::ShapeFunction::gimp, hmpm::ShapeFunction::bspline}) {
     hmpm::Problem p;
     p.dimension = 2;
     p.grid.max = {2.0, 2.0, 0};
@@ -38,7 +39,9 @@ TEST(Conservation, FreeBodyMomentumAndMass) {
     b.box.max = {1.4, 1.4, 0};
     b.particles_per_cell = 2;
     b.initial.velocity[0] = [](const hmpm::Vec3& x) { return 0.5 - 2.0 * (x[1] - 1.0); };
-    b.initial.velocity[1] = [](const hmpm::Vec3& x) { return -0.3 + 2.0 * (x[0] - 1.0) + 1.5 * (x[0] - 1.0) * (x[0] - 1.0); };
+    b.initial.velocity[1] = [](const hmpm::Vec3& x) {
+      return -0.3 + 2.0 * (x[0] - 1.0) + 1.5 * (x[0] - 1.0) * (x[0] - 1.0);
+    };
     p.bodies.push_back(b);
     p.time.end = 0.1;
     p.output.snapshot_interval = 0.02;
@@ -169,23 +172,24 @@ double bar_energy(const hmpm::Snapshot& s, double Q) {
 }
 
 // The rho_f a term of Darcy's law uses the acceleration of the re-mapped
-// nodal velocities of the same step. A saturated bar vibrating freely (closed: no drainage, no load) can
-// only lose energy to Darcy flow; kinetic + elastic + fluid storage energy
-// must never grow by more than the explicit scheme's O(w dt) oscillation
-// (asserted 2 %), from low to very high permeability where the term
-// dominates the flux, and the run must stay finite.
+// nodal velocities of the same step. A saturated bar vibrating freely (closed: no drainage, no
+// load) can only lose energy to Darcy flow; kinetic + elastic + fluid storage energy must never
+// grow by more than the explicit scheme's O(w dt) oscillation (asserted 2 %), from low to very high
+// permeability where the term dominates the flux, and the run must stay finite.
 TEST(DarcyInertia, SameStepAccelerationIsStable) {
   for (double k : {1e-4, 1e-2, 0.3}) {  // at 0.3 m/s, (k/g) w = 20: the term dominates
     hmpm::Problem p = problems::column(1, 0, 1.0, 20, 2);
     hmpm::Material m = elastic(2000, 20e6, 0.0);
     m.hydraulic = hmpm::Hydraulic{0.3, k, 100e6, 1000.0, std::numeric_limits<double>::infinity()};
     p.materials.push_back(m);
-    p.bodies[0].initial.velocity[0] = [](const hmpm::Vec3& x) { return 0.05 * std::sin(1.5707963 * x[0]); };
+    p.bodies[0].initial.velocity[0] = [](const hmpm::Vec3& x) {
+      return 0.05 * std::sin(1.5707963 * x[0]);
+    };
     p.boundaries.push_back(problems::fixed_velocity(problems::plane(p, 0, 0.0), 0));
     p.time.end = 0.03;  // 3 periods of the undrained first mode
     p.output.snapshot_interval = 0.0005;
-    p.output.snapshot_fields = {hmpm::Field::velocity, hmpm::Field::effective_stress, hmpm::Field::strain,
-                                hmpm::Field::pore_pressure};
+    p.output.snapshot_fields = {hmpm::Field::velocity, hmpm::Field::effective_stress,
+                                hmpm::Field::strain, hmpm::Field::pore_pressure};
     const double Q = 0.3 / 100e6;
     std::vector<double> energy;
     hmpm::RunOptions opt;
@@ -196,8 +200,8 @@ TEST(DarcyInertia, SameStepAccelerationIsStable) {
     const hmpm::RunResult r = hmpm::run(p, opt);
     ASSERT_EQ(r.status, hmpm::RunStatus::successful) << "k " << k << ": " << r.message;
     const double peak = *std::max_element(energy.begin(), energy.end());
-    std::printf("darcy inertia k=%g: peak/initial energy %.4f, final/initial %.4f\n", k, peak / energy[0],
-                energy.back() / energy[0]);
+    std::printf("darcy inertia k=%g: peak/initial energy %.4f, final/initial %.4f\n", k,
+                peak / energy[0], energy.back() / energy[0]);
     EXPECT_LT(peak, 1.02 * energy[0]) << "k " << k;
     EXPECT_LT(energy.back(), energy[0]) << "k " << k;
   }
@@ -230,16 +234,19 @@ TEST(DarcyInertia, CompressibleFluidGrowsAtTheRateOfTheEquations) {
     const double Q = c.times_limit * limit / E;  // E Q = times_limit x the limit
     hmpm::Problem p = problems::column(1, 0, L, 20, 2);
     hmpm::Material m = elastic(rho_s, E, 0.0);
-    m.hydraulic = hmpm::Hydraulic{n, k, n / Q, rho_f, std::numeric_limits<double>::infinity(), c.inertia};
+    m.hydraulic =
+        hmpm::Hydraulic{n, k, n / Q, rho_f, std::numeric_limits<double>::infinity(), c.inertia};
     p.materials.push_back(m);
     const double q = std::acos(-1.0) / (2 * L);
-    p.bodies[0].initial.velocity[0] = [q](const hmpm::Vec3& x) { return 1e-3 * std::sin(q * x[0]); };
+    p.bodies[0].initial.velocity[0] = [q](const hmpm::Vec3& x) {
+      return 1e-3 * std::sin(q * x[0]);
+    };
     p.boundaries.push_back(problems::fixed_velocity(problems::plane(p, 0, 0.0), 0));
     p.boundaries.push_back(problems::fixed_pressure(problems::plane(p, 0, L), 0.0));
     p.time.end = 0.15;  // about 6 periods
     p.output.snapshot_interval = 0.0005;
-    p.output.snapshot_fields = {hmpm::Field::velocity, hmpm::Field::effective_stress, hmpm::Field::strain,
-                                hmpm::Field::pore_pressure};
+    p.output.snapshot_fields = {hmpm::Field::velocity, hmpm::Field::effective_stress,
+                                hmpm::Field::strain, hmpm::Field::pore_pressure};
     std::vector<double> time, log_energy;
     hmpm::RunOptions opt;
     opt.on_snapshot = [&](const hmpm::Snapshot& s) {
@@ -253,7 +260,8 @@ TEST(DarcyInertia, CompressibleFluidGrowsAtTheRateOfTheEquations) {
     ASSERT_EQ(r.status, hmpm::RunStatus::successful) << r.message;
     // Least-squares slope of log(energy) against time.
     const double tm = std::accumulate(time.begin(), time.end(), 0.0) / time.size();
-    const double lm = std::accumulate(log_energy.begin(), log_energy.end(), 0.0) / log_energy.size();
+    const double lm =
+        std::accumulate(log_energy.begin(), log_energy.end(), 0.0) / log_energy.size();
     double stt = 0, stl = 0;
     for (std::size_t i = 0; i < time.size(); ++i) {
       stt += (time[i] - tm) * (time[i] - tm);

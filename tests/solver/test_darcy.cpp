@@ -32,16 +32,18 @@ hmpm::Problem darcy(const DarcyCase& d, double end) {
   m.name = "sand";
   m.density = 2650;
   m.youngs_modulus = 1e7;
-  m.hydraulic = hmpm::Hydraulic{d.porosity, d.k, d.kf, 1000.0,
-                                std::numeric_limits<double>::infinity()};
+  m.hydraulic =
+      hmpm::Hydraulic{d.porosity, d.k, d.kf, 1000.0, std::numeric_limits<double>::infinity()};
   p.materials.push_back(m);
   hmpm::Boundary fixed;  // the skeleton does not move
   fixed.nodes.all = true;
   fixed.has_velocity = true;
   for (int a = 0; a < d.dim; ++a) fixed.velocity[a] = problems::constant(0.0);
   p.boundaries.push_back(fixed);
-  p.boundaries.push_back(problems::fixed_pressure(problems::plane(p, 0, 0.0), d.reversed ? 0.0 : d.dp));
-  p.boundaries.push_back(problems::fixed_pressure(problems::plane(p, 0, d.L), d.reversed ? d.dp : 0.0));
+  p.boundaries.push_back(
+      problems::fixed_pressure(problems::plane(p, 0, 0.0), d.reversed ? 0.0 : d.dp));
+  p.boundaries.push_back(
+      problems::fixed_pressure(problems::plane(p, 0, d.L), d.reversed ? d.dp : 0.0));
   p.time.end = end;
   const auto n = hmpm::count_particles(p);
   for (std::int64_t i = 0; i < n; ++i) p.output.series_particles.push_back(i);
@@ -61,10 +63,15 @@ double exact(const DarcyCase& d, double x, double t) {
 TEST(DarcyFlow, SteadyPressureAndDarcyVelocityExactAtEveryParticle) {
   std::vector<DarcyCase> cases(6);
   cases[1].reversed = true;
-  cases[2].L = 3.0; cases[2].dp = 2.5e4; cases[2].k = 1e-5; cases[2].cells = 17;
+  cases[2].L = 3.0;
+  cases[2].dp = 2.5e4;
+  cases[2].k = 1e-5;
+  cases[2].cells = 17;
   cases[3].dim = 2;
-  cases[4].dim = 3; cases[4].reversed = true;
-  cases[5].ppc = 2; cases[5].porosity = 0.45;
+  cases[4].dim = 3;
+  cases[4].reversed = true;
+  cases[5].ppc = 2;
+  cases[5].porosity = 0.45;
   for (const DarcyCase& d : cases) {
     const double end = 3.0 * d.L * d.L / d.c();
     hmpm::Problem p = darcy(d, end);
@@ -77,9 +84,12 @@ TEST(DarcyFlow, SteadyPressureAndDarcyVelocityExactAtEveryParticle) {
     for (std::size_t i = 0; i < np; ++i) {
       const double x = s.initial_positions[i][0];
       const double p_exact = d.dp * (d.reversed ? x / d.L : 1 - x / d.L);
-      EXPECT_NEAR(s.values[0][last * np + i], p_exact, 1e-6 * d.dp) << "particle " << i << " dim " << d.dim;
-      EXPECT_NEAR(s.values[1][(last * np + i) * d.dim], w_exact, 1e-6 * std::abs(w_exact)) << "particle " << i;
-      for (int a = 1; a < d.dim; ++a) EXPECT_NEAR(s.values[1][(last * np + i) * d.dim + a], 0.0, 1e-9 * std::abs(w_exact));
+      EXPECT_NEAR(s.values[0][last * np + i], p_exact, 1e-6 * d.dp)
+          << "particle " << i << " dim " << d.dim;
+      EXPECT_NEAR(s.values[1][(last * np + i) * d.dim], w_exact, 1e-6 * std::abs(w_exact))
+          << "particle " << i;
+      for (int a = 1; a < d.dim; ++a)
+        EXPECT_NEAR(s.values[1][(last * np + i) * d.dim + a], 0.0, 1e-9 * std::abs(w_exact));
     }
   }
 }
@@ -101,7 +111,8 @@ TransientError transient_error(const DarcyCase& d, double tv_min, double tv_max)
   for (std::size_t row = 0; row < s.time.size(); ++row) {
     if (s.time[row] * d.c() / (d.L * d.L) < tv_min) continue;
     for (std::size_t i = 0; i < np; ++i) {
-      const double err = std::abs(s.values[0][row * np + i] - exact(d, s.initial_positions[i][0], s.time[row]));
+      const double err =
+          std::abs(s.values[0][row * np + i] - exact(d, s.initial_positions[i][0], s.time[row]));
       e.max_abs = std::max(e.max_abs, err);
     }
   }

@@ -43,7 +43,8 @@ hmpm::Problem terzaghi(const TerzaghiCase& c, double end) {
   m.density = c.rho_s;
   m.youngs_modulus = c.E;
   m.poisson_ratio = c.nu;
-  m.hydraulic = hmpm::Hydraulic{c.porosity, c.k, c.kw, 1000.0, std::numeric_limits<double>::infinity()};
+  m.hydraulic =
+      hmpm::Hydraulic{c.porosity, c.k, c.kw, 1000.0, std::numeric_limits<double>::infinity()};
   p.materials.push_back(m);
   const double q = c.q;
   // Zero effective stress initially: the total stress -q is carried by the water.
@@ -66,8 +67,8 @@ hmpm::Problem terzaghi(const TerzaghiCase& c, double end) {
 }
 
 struct Errors {
-  double max_pressure = 0;   // over particles, relative to q
-  double max_degree = 0;     // |U - U_exact|
+  double max_pressure = 0;  // over particles, relative to q
+  double max_degree = 0;    // |U - U_exact|
   std::vector<double> tv;
 };
 
@@ -128,10 +129,22 @@ TEST(Terzaghi, PublicCaseWithAutomaticStep) {
 // undrained to drained stiffness, so stiffer skeletons keep these cheap.
 TEST(Terzaghi, VariantsEmbeddedIn2DAnd3D) {
   TerzaghiCase a;
-  a.dim = 2; a.axis = 1; a.H = 2.0; a.cells = 20; a.ppc = 2;
-  a.E = 50e6; a.nu = 0.25; a.k = 2e-5; a.q = 5e4; a.porosity = 0.4;
+  a.dim = 2;
+  a.axis = 1;
+  a.H = 2.0;
+  a.cells = 20;
+  a.ppc = 2;
+  a.E = 50e6;
+  a.nu = 0.25;
+  a.k = 2e-5;
+  a.q = 5e4;
+  a.porosity = 0.4;
   TerzaghiCase b;
-  b.dim = 3; b.axis = 2; b.cells = 20; b.E = 50e6; b.k = 1e-5;
+  b.dim = 3;
+  b.axis = 2;
+  b.cells = 20;
+  b.E = 50e6;
+  b.k = 1e-5;
   for (const TerzaghiCase& c : {a, b}) {
     ASSERT_LT(c.inertia_number(0.05), 0.003) << "dim " << c.dim;
     const Errors e = run_terzaghi(c);

@@ -69,26 +69,27 @@ hmpm::Problem dry_block() {
 // non-chaotic elastic response they stay below 1e-9 of each field's scale.
 TEST(Threads, TwoThreadsAgreeWithOneAndAreDeterministic) {
   for (bool dry : {false, true})
-  for (auto shape : {hmpm::ShapeFunction::linear, hmpm::ShapeFunction::gimp}) {
-    hmpm::Problem p = dry ? dry_block() : saturated_block();
-    p.shape_function = shape;
-    const std::vector<double> one = final_state(p, 1);
-    ASSERT_FALSE(one.empty());
-    double scale = 0;
-    for (double v : one) scale = std::max(scale, std::abs(v));
-    // Three threads: two private buffers, each reduced over its own band of nodes.
-    for (int threads : {2, 3}) {
-      const std::vector<double> many = final_state(p, threads);
-      const std::vector<double> again = final_state(p, threads);
-      ASSERT_EQ(one.size(), many.size());
-      double worst = 0;
-      for (std::size_t i = 0; i < one.size(); ++i) worst = std::max(worst, std::abs(one[i] - many[i]));
-      std::printf("threads (%s): %d against 1, largest difference %.2e of the largest value\n",
-                  dry ? "dry" : "saturated", threads, worst / scale);
-      EXPECT_LT(worst, 1e-9 * scale) << threads << " threads";
-      EXPECT_EQ(many, again) << threads << " threads";
+    for (auto shape : {hmpm::ShapeFunction::linear, hmpm::ShapeFunction::gimp}) {
+      hmpm::Problem p = dry ? dry_block() : saturated_block();
+      p.shape_function = shape;
+      const std::vector<double> one = final_state(p, 1);
+      ASSERT_FALSE(one.empty());
+      double scale = 0;
+      for (double v : one) scale = std::max(scale, std::abs(v));
+      // Three threads: two private buffers, each reduced over its own band of nodes.
+      for (int threads : {2, 3}) {
+        const std::vector<double> many = final_state(p, threads);
+        const std::vector<double> again = final_state(p, threads);
+        ASSERT_EQ(one.size(), many.size());
+        double worst = 0;
+        for (std::size_t i = 0; i < one.size(); ++i)
+          worst = std::max(worst, std::abs(one[i] - many[i]));
+        std::printf("threads (%s): %d against 1, largest difference %.2e of the largest value\n",
+                    dry ? "dry" : "saturated", threads, worst / scale);
+        EXPECT_LT(worst, 1e-9 * scale) << threads << " threads";
+        EXPECT_EQ(many, again) << threads << " threads";
+      }
     }
-  }
 }
 
 }  // namespace

@@ -10,7 +10,7 @@
 `Client` sends requests; `Job` is a handle on one job id. Every refusal by
 the service raises `HmpmError` with the service's problem document; network
 failures raise `HmpmError` too (type `connection-error`, no HTTP status).
-The HTTP contract is in docs/api.md and ../shared/CONTRACT.md.
+The HTTP contract is in docs/api.md and docs/contract.md.
 """
 
 from __future__ import annotations

@@ -72,7 +72,7 @@ struct LinearElastic {};
 struct MohrCoulomb {
   double friction_angle_deg = 30.0;
   double dilatancy_angle_deg = 0.0;
-  double cohesion = 0.0;  ///< Pa
+  double cohesion = 0.0;          ///< Pa
   double tensile_strength = 0.0;  ///< Pa; cut-off on the major principal stress
 };
 
@@ -145,8 +145,8 @@ struct Boundary {
 /// Force = traction * (particle volume / its initial length along the face normal).
 struct Traction {
   Box particles;
-  int axis = 0;   ///< face normal axis: 0 = x, 1 = y, 2 = z
-  int side = +1;  ///< +1 for "x+", -1 for "x-"
+  int axis = 0;                         ///< face normal axis: 0 = x, 1 = y, 2 = z
+  int side = +1;                        ///< +1 for "x+", -1 for "x-"
   std::array<FieldOfTime, 3> traction;  ///< Pa, per axis
 };
 
@@ -182,17 +182,17 @@ struct InitialState {
 };
 
 struct TimeControl {
-  double end = 1.0;           ///< s, required
-  std::optional<double> dt;   ///< s; absent: automatic
-  double courant = 0.5;       ///< factor on the stable step when dt is automatic
+  double end = 1.0;          ///< s, required
+  std::optional<double> dt;  ///< s; absent: automatic
+  double courant = 0.5;      ///< factor on the stable step when dt is automatic
 };
 
 struct OutputRequest {
   std::vector<std::int64_t> series_particles;  ///< global particle indices
   std::vector<Field> series_fields;
-  double series_interval = 0.0;  ///< s; <= 0: every step
+  double series_interval = 0.0;        ///< s; <= 0: every step
   std::vector<Field> snapshot_fields;  ///< empty: all fields
-  double snapshot_interval = 0.0;  ///< s; <= 0: no snapshots
+  double snapshot_interval = 0.0;      ///< s; <= 0: no snapshots
 };
 
 struct Problem {

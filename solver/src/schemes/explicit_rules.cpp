@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "format.hpp"
+#include "hmpm/format.hpp"
 #include "hmpm/problem.hpp"
 #include "hmpm/run.hpp"
 #include "materials/material.hpp"
@@ -66,7 +66,7 @@ StableStep explicit_stable_step(const Problem& problem) {
 void check_explicit_step(const Problem& problem, const StableStep& s,
                          std::vector<ProblemIssue>& issues) {
   if (!problem.time.dt || *problem.time.dt <= s.limit * (1.0 + 1e-12)) return;
-  auto fmt = [](double v) { return format_number(v, 4); };
+  auto fmt = [](double v) { return format_significant(v, 4); };
   std::string why = s.hydraulic < s.mechanical
                         ? "the explicit hydraulic diffusion limit h^2/(2 d k/(gamma_w Q))"
                         : "the mechanical limit h/(c sqrt(d)) with undrained wave speed c = " +
