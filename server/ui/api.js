@@ -25,7 +25,8 @@ export function auth_headers(extra = {}) {
 // `problem`, the server's problem document (or a stand-in with `detail`).
 export class ApiError extends Error {
   constructor(status, problem) {
-    super(problem.detail || problem.title || `HTTP ${status}`);
+    const text = problem.detail || problem.title || `HTTP ${status}`;
+    super(status === 401 ? `${text} (enter the server's token in the Token field at the top)` : text);
     this.status = status;
     this.problem = problem;
   }

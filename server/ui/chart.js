@@ -104,14 +104,6 @@ export function colour(t) {
 // null) coloured by `values` on the canvas, with a colour bar on the right.
 // `bounds` ({min: [x, y], max: [x, y]}) fixes the view, e.g. to the grid.
 export function draw_particles(canvas, points, values, sizes, { bounds = null, label = '' } = {}) {
-  const ratio = window.devicePixelRatio || 1;
-  const css_w = canvas.clientWidth || 760;
-  const css_h = canvas.clientHeight || 420;
-  canvas.width = Math.round(css_w * ratio);
-  canvas.height = Math.round(css_h * ratio);
-  const ctx = canvas.getContext('2d');
-  ctx.setTransform(ratio, 0, 0, ratio, 0, 0);
-  ctx.clearRect(0, 0, css_w, css_h);
   const n = values.length;
   const bar_w = 86;
   const pad = 28;
@@ -133,6 +125,17 @@ export function draw_particles(canvas, points, values, sizes, { bounds = null, l
   }
   const span_x = xmax - xmin || 1;
   const span_y = ymax - ymin;
+  // the canvas takes the domain's aspect ratio (within limits)
+  const ratio = window.devicePixelRatio || 1;
+  const css_w = canvas.clientWidth || 760;
+  const fit = span_y > 0 ? ((css_w - bar_w - 2 * pad) * span_y) / span_x + 2 * pad : 170;
+  const css_h = Math.round(Math.max(170, Math.min(560, fit)));
+  canvas.style.height = `${css_h}px`;
+  canvas.width = Math.round(css_w * ratio);
+  canvas.height = Math.round(css_h * ratio);
+  const ctx = canvas.getContext('2d');
+  ctx.setTransform(ratio, 0, 0, ratio, 0, 0);
+  ctx.clearRect(0, 0, css_w, css_h);
   const area_w = css_w - bar_w - 2 * pad;
   const area_h = css_h - 2 * pad;
   const scale = span_y > 0 ? Math.min(area_w / span_x, area_h / span_y) : area_w / span_x;

@@ -18,6 +18,18 @@ export function h(tag, attrs = {}, ...children) {
   return el;
 }
 
+// SI units of the output fields (CONTRACT.md), for axis and colour-bar labels.
+const UNITS = {
+  position: 'm', displacement: 'm', velocity: 'm/s', pore_pressure: 'Pa', darcy_velocity: 'm/s',
+  effective_stress: 'Pa', total_stress: 'Pa', volume: 'm³', strain: '', porosity: '', material: '',
+};
+
+// "pore pressure (Pa)", "velocity x (m/s)".
+export function field_label(name, component = '') {
+  const unit = UNITS[name];
+  return `${name.replace(/_/g, ' ')}${component ? ` ${component}` : ''}${unit ? ` (${unit})` : ''}`;
+}
+
 export const STATUSES = ['accepted', 'running', 'successful', 'failed', 'dismissed'];
 
 export function is_active(status) {

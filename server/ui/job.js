@@ -7,6 +7,7 @@ import { download, get_json, get_text, read_events, request } from '/ui/api.js';
 import { bytes, confirm_dialog, duration, h, is_active, job_id, local_time, notice, num, pretty_json, progress_bar, status_badge } from '/ui/dom.js';
 import { series_panel } from '/ui/series.js';
 import { snapshot_panel } from '/ui/snapshot.js';
+import { expected_seconds } from '/ui/submit.js';
 
 const LOG_POLL_MS = 2000;
 const STATUS_POLL_MS = 1000;
@@ -73,6 +74,7 @@ export function render(main, id) {
         fact('Started', local_time(job.started)),
         fact('Finished', local_time(job.finished)),
         fact('Run time', duration(job.run_seconds)),
+        expected_seconds(job) !== undefined ? fact('Expected', duration(expected_seconds(job))) : null,
         fact('Particles', cost.particles ?? '—'),
         fact('Steps', cost.steps ?? '—'),
         fact('Time step', cost.dt !== undefined ? `${num(cost.dt)} s` : '—'),
@@ -120,6 +122,7 @@ export function render(main, id) {
     try {
       await read_events(`${base}/events`, (name, data) => {
         try {
+          head.dataset.live = 'events';  // where the progress comes from (tests read it)
           update(JSON.parse(data));
         } catch { /* a malformed event: the next one or the poll repairs it */ }
       }, abort.signal);
@@ -134,6 +137,7 @@ export function render(main, id) {
 
   async function poll() {
     try {
+      head.dataset.live = 'poll';
       update(await get_json(base, { signal: abort.signal }));
     } catch (err) {
       if (err.name === 'AbortError') return;

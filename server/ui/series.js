@@ -4,7 +4,7 @@
 // chosen time.
 
 import { get_json } from '/ui/api.js';
-import { h, notice, num } from '/ui/dom.js';
+import { field_label, h, notice, num } from '/ui/dom.js';
 import { line_chart, PALETTE } from '/ui/chart.js';
 import { component_names } from '/ui/vtu.js';
 
@@ -79,8 +79,7 @@ export async function series_panel(root, href) {
     const f = field.value;
     const c = Number(component.value);
     const chosen = picks.filter((p) => p.checked).map((p) => Number(p.value));
-    const comp_name = component.hidden ? '' : ` ${component.selectedOptions[0]?.textContent || ''}`;
-    const y_label = `${f.replace(/_/g, ' ')}${comp_name}`;
+    const y_label = field_label(f, component.hidden ? '' : component.selectedOptions[0]?.textContent || '');
     profile_only.hidden = mode.value !== 'profile';
     picks.forEach((p, k) => {
       const rank = chosen.indexOf(k);

@@ -2,7 +2,7 @@
 // positions (x, y; 3D is seen along z) and coloured by a chosen field.
 
 import { get_text } from '/ui/api.js';
-import { h, notice, num } from '/ui/dom.js';
+import { field_label, h, notice, num } from '/ui/dom.js';
 import { draw_particles } from '/ui/chart.js';
 import { component_names, field_values, parse_vtu } from '/ui/vtu.js';
 
@@ -67,11 +67,10 @@ export async function snapshot_panel(root, files, pvd_href, get_spec) {
     if (!f) return;
     const spec = get_spec() || {};
     const dim = spec.dimension || 2;
-    canvas.classList.toggle('one-d', dim === 1);
     const volume = current.fields.find((x) => x.name === 'volume');
     const sizes = volume ? Array.from(volume.values, (v) => Math.abs(v) ** (1 / dim)) : null;
     const values = field_values(f, Number(component.value));
-    const label = `${f.name.replace(/_/g, ' ')}${component.hidden ? '' : ` ${component.selectedOptions[0].textContent}`}`;
+    const label = field_label(f.name, component.hidden ? '' : component.selectedOptions[0].textContent);
     const grid = spec.grid && spec.grid.min && spec.grid.max ? spec.grid : null;
     const result = draw_particles(canvas, current.points, values, sizes, { bounds: grid, label });
     canvas.dataset.drawn = result.drawn;

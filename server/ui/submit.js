@@ -12,6 +12,12 @@ const DEBOUNCE_MS = 500;
 const KNOWN_EXAMPLES = ['bar-vibration', 'column-collapse', 'darcy-flow', 'geostatic', 'mandel', 'slope-failure', 'terzaghi'];
 const DRAFT_KEY = 'hmpm.draft';
 
+// The expected wall time in seconds, wherever the server puts it.
+export function expected_seconds(doc) {
+  const candidates = [doc?.estimate?.wall_seconds, doc?.cost?.wall_seconds, doc?.cost?.expected_wall_seconds, doc?.expected_wall_seconds];
+  return candidates.find((v) => Number.isFinite(v));
+}
+
 export function render(main) {
   const examples = h('select', { id: 'example-select', 'aria-label': 'example' }, h('option', { value: '' }, 'Load an example…'));
   const file = h('input', { id: 'spec-file', type: 'file', accept: '.json,application/json', class: 'file-input' });
@@ -93,7 +99,7 @@ export function render(main) {
     marked_lines = new Set();
     show(problems, result.errors || []);
     show(warnings, result.warnings || []);
-    show_cost(result.cost, result.estimate);
+    show_cost(result.cost, expected_seconds(result));
     draw_gutter();
   }
 
@@ -155,6 +161,7 @@ export function render(main) {
 
   function changed() {
     draw_gutter();
+    if (editor.value.trim()) set_state('checking', 'Checking…');
     clearTimeout(debounce);
     debounce = setTimeout(validate, DEBOUNCE_MS);
   }

@@ -5,6 +5,8 @@
   default build/bin) on a free loopback port, with a fresh database; with
   HMPM_UI_PROXY=1, tests/browser/dev_proxy.py in front of it (for servers
   that do not serve /ui yet; it runs `hmpm validate -` for POST /validate).
+- HMPM_TOKEN set: the server started here requires it, and the tests send it
+  (the page reads it from localStorage, as the header's Token field stores it).
 """
 
 import os
@@ -54,7 +56,8 @@ class Service:
         self.tmp = tempfile.mkdtemp(prefix="hmpm-ui-test-")
         proc = subprocess.Popen(
             [str(server), "--host", "127.0.0.1", "--port", "0", "--db", f"{self.tmp}/db.sqlite",
-             "--data-dir", f"{self.tmp}/results", "--workers", "2"],
+             "--data-dir", f"{self.tmp}/results", "--workers", "2"]
+            + (["--token", os.environ["HMPM_TOKEN"]] if os.environ.get("HMPM_TOKEN") else []),
             stdout=subprocess.PIPE, stderr=self._log("server.log"), text=True)
         self.procs.append(proc)
         self.url = _first_line(proc, "hmpm-server")

@@ -94,7 +94,7 @@ class Dashboard(unittest.TestCase):
         self.driver.get(f"{self.service.url}/ui{fragment}")
         if TOKEN:
             self.driver.execute_script("localStorage.setItem('hmpm.token', arguments[0])", TOKEN)
-            self.driver.get(f"{self.service.url}/ui{fragment}")
+            self.driver.refresh()  # a get() of the same URL would only be a fragment change
 
     def css(self, selector, timeout=UI_TIMEOUT_S):
         return wait_until(lambda: self.driver.find_elements(By.CSS_SELECTOR, selector), timeout, selector)[0]
@@ -179,14 +179,22 @@ class Dashboard(unittest.TestCase):
         wait_until(lambda: '"terzaghi"' in self.driver.find_element(By.ID, "spec-text").get_attribute("value"), UI_TIMEOUT_S, "the example")
         wait_until(lambda: self.driver.find_element(By.ID, "validation-state").get_attribute("class").split()[-1] in ("valid", "idle"),
                    UI_TIMEOUT_S, "validation of the example")
-        self.set_editor(json.dumps(short_terzaghi(), indent=2))
+        text = self.driver.find_element(By.ID, "spec-text").get_attribute("value")  # the example's own layout
+        text = text.replace('"name": "terzaghi"', '"name": "terzaghi-short"').replace('"end": 51.0', '"end": 20.4')
+        self.assertEqual(json.loads(text), short_terzaghi())
+        self.set_editor(text)
         wait_until(lambda: self.driver.find_element(By.ID, "validation-state").get_attribute("class").split()[-1] in ("valid", "idle"),
                    UI_TIMEOUT_S, "validation of the spec")
+        validated = "valid" in self.driver.find_element(By.ID, "validation-state").get_attribute("class").split()
+        cost_shown = self.driver.find_element(By.ID, "validation-cost").text
         self.screenshot("submit")
         self.driver.find_element(By.ID, "submit-job").click()
         url = wait_until(lambda: "#/jobs/" in self.driver.current_url and self.driver.current_url, UI_TIMEOUT_S, "the job page")
         job_id = url.rsplit("/", 1)[1]
-        self.assertEqual(self.call("GET", f"/jobs/{job_id}")["name"], "terzaghi-short")
+        doc = self.call("GET", f"/jobs/{job_id}")
+        self.assertEqual(doc["name"], "terzaghi-short")
+        if validated:  # the cost shown before submitting is the job's
+            self.assertIn(f"steps\n{doc['cost']['steps']}", cost_shown)
         seen = set()
 
         def ended():
@@ -248,6 +256,7 @@ class Dashboard(unittest.TestCase):
             return len(seen - {0}) >= 2
 
         wait_until(moving, 60, "the progress to move twice")
+        self.assertEqual(self.css("#job-head").get_attribute("data-live"), "events", "progress from the event stream")
         self.assertEqual(self.css("#job-status .badge").text.lower(), "running")
         self.assertTrue(self.css("#cancel-job").is_enabled())
         self.screenshot("job-running")
