@@ -3,11 +3,11 @@
 // of series.json, a snapshot view, the result files, the spec, and cancel
 // and delete behind a confirmation.
 
-import { download, get_json, get_text, read_events, request } from '/ui/api.js';
+import { download, get_json, get_text, read_events, request, token } from '/ui/api.js';
 import { bytes, confirm_dialog, duration, h, is_active, job_id, local_time, notice, num, pretty_json, progress_bar, status_badge } from '/ui/dom.js';
 import { series_panel } from '/ui/series.js';
 import { snapshot_panel } from '/ui/snapshot.js';
-import { expected_seconds } from '/ui/submit.js';
+import { DRAFT_KEY, expected_seconds } from '/ui/submit.js';
 
 const LOG_POLL_MS = 2000;
 const STATUS_POLL_MS = 1000;
@@ -21,6 +21,7 @@ export function render(main, id) {
   let timers = [];
   let results_loaded = false;
   let spec = null;
+  let spec_text = '';
 
   const head = h('section', { class: 'card job-head', id: 'job-head' }, notice('info', 'Loading…'));
   const warnings = h('div', { id: 'job-warnings' });
@@ -32,13 +33,17 @@ export function render(main, id) {
   const log_note = h('div', { class: 'muted small', id: 'log-note' });
   const spec_pre = h('pre', { class: 'json', id: 'job-spec' }, '…');
 
+  // shown once the job has results
+  const series_card = h('section', { class: 'card', hidden: true }, h('div', { class: 'card-head' }, h('h3', {}, 'Series')), series_body);
+  const snapshot_card = h('section', { class: 'card', hidden: true }, h('div', { class: 'card-head' }, h('h3', {}, 'Snapshot')), snapshot_body);
+
   main.append(
     h('div', { class: 'crumbs' }, h('a', { href: '#/jobs' }, '← All jobs')),
     head,
     action_message,
     warnings,
-    h('section', { class: 'card' }, h('div', { class: 'card-head' }, h('h3', {}, 'Series')), series_body),
-    h('section', { class: 'card' }, h('div', { class: 'card-head' }, h('h3', {}, 'Snapshot')), snapshot_body),
+    series_card,
+    snapshot_card,
     h('div', { class: 'two-col' },
       h('section', { class: 'card' }, h('div', { class: 'card-head' }, h('h3', {}, 'Result files')), results_body),
       h('section', { class: 'card' }, h('div', { class: 'card-head' }, h('h3', {}, 'Log'), log_note), log_pre)),
@@ -60,11 +65,12 @@ export function render(main, id) {
   function draw_head() {
     const cancel = h('button', { class: 'btn', id: 'cancel-job', disabled: !is_active(job.status), onclick: cancel_job }, 'Cancel');
     const remove = h('button', { class: 'btn btn-danger', id: 'delete-job', disabled: job.status === 'dismissed', onclick: delete_job }, 'Delete');
+    const again = h('button', { class: 'btn', id: 'edit-job', disabled: !spec_text, onclick: edit_again, title: 'open this spec on the submit page' }, 'Edit & resubmit');
     const cost = job.cost || {};
     head.replaceChildren(
       h('div', { class: 'job-title' },
         h('div', {}, h('h2', { id: 'job-name' }, job.name || '(unnamed)'), h('div', { class: 'muted' }, 'Job ', h('span', { id: 'job-id' }, job_id(job.jobID)))),
-        h('div', { class: 'actions' }, cancel, remove)),
+        h('div', { class: 'actions' }, again, cancel, remove)),
       h('div', { class: 'job-status-row' },
         h('span', { id: 'job-status' }, status_badge(job.status)),
         h('div', { class: 'grow', id: 'job-progress' }, progress_bar(job.progress, job.status)),
@@ -148,6 +154,8 @@ export function render(main, id) {
   async function load_spec() {
     try {
       const text = await get_text(`${base}/spec`, { signal: abort.signal });
+      spec_text = text;
+      if (job) draw_head();
       try {
         spec = JSON.parse(text);
         // the bytes as submitted when a person laid them out, else indented
@@ -191,10 +199,12 @@ export function render(main, id) {
     } catch (err) {
       if (err.name === 'AbortError') return;
       const text = err.status === 410 ? 'The job was dismissed: its result files are deleted.' : `No results: ${err.message}`;
-      for (const el of [results_body, series_body, snapshot_body]) el.replaceChildren(h('p', { class: 'muted' }, text));
+      results_body.replaceChildren(h('p', { class: 'muted' }, text));
+      series_card.hidden = snapshot_card.hidden = true;
       return;
     }
     const files = manifest.files || [];
+    series_card.hidden = snapshot_card.hidden = false;
     results_body.replaceChildren(
       h('table', { class: 'files', id: 'result-files' },
         h('thead', {}, h('tr', {}, h('th', {}, 'File'), h('th', { class: 'num' }, 'Size'), h('th', {}, 'Type'))),
@@ -212,9 +222,14 @@ export function render(main, id) {
   }
 
   function download_click(event, file) {
-    if (!localStorage.getItem('hmpm.token')) return;  // a plain link works
+    if (!token()) return;  // a plain link works
     event.preventDefault();
     download(file.href, file.name).catch((err) => action_message.replaceChildren(notice('error', `Download failed: ${err.message}`)));
+  }
+
+  function edit_again() {
+    localStorage.setItem(DRAFT_KEY, spec_text);  // the submit page opens its draft
+    location.hash = '#/submit';
   }
 
   async function cancel_job() {
