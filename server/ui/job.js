@@ -63,6 +63,7 @@ export function render(main, id) {
   }
 
   function draw_head() {
+    document.title = `${job.name || job.jobID.slice(0, 8)} · ${job.status} · hmpm`;
     const cancel = h('button', { class: 'btn', id: 'cancel-job', disabled: !is_active(job.status), onclick: cancel_job }, 'Cancel');
     const remove = h('button', { class: 'btn btn-danger', id: 'delete-job', disabled: job.status === 'dismissed', onclick: delete_job }, 'Delete');
     const again = h('button', { class: 'btn', id: 'edit-job', disabled: !spec_text, onclick: edit_again, title: 'open this spec on the submit page' }, 'Edit & resubmit');
@@ -239,7 +240,7 @@ export function render(main, id) {
       update(await response.json());
       action_message.replaceChildren(notice('info', 'The job was cancelled.'));
     } catch (err) {
-      if (err.status === 409) action_message.replaceChildren(notice('warn', `Nothing changed: ${err.message}`));
+      if (err.status === 409) action_message.replaceChildren(notice('warn', `Not cancelled (the job has ended; nothing changed): ${err.message}`));
       else if (err.status === 404 || err.status === 405) action_message.replaceChildren(notice('warn', 'This server has no separate cancel (POST /jobs/{id}/cancel); Delete stops the job and deletes its results.'));
       else action_message.replaceChildren(notice('error', `Cancel failed: ${err.message}`));
       load_job_quietly();

@@ -9,6 +9,7 @@ import { STATUSES, age, h, job_id, notice, progress_bar, status_badge } from '/u
 const POLL_MS = 2000;
 
 export function render(main) {
+  document.title = 'Jobs · hmpm';
   const query = new URLSearchParams(location.hash.split('?')[1] || '');
   const status_select = h(
     'select',

@@ -2,7 +2,9 @@
 // positions (x, y; 3D is seen along z) and coloured by a chosen field.
 
 import { get_text } from '/ui/api.js';
-import { field_label, h, notice, num } from '/ui/dom.js';
+import { bytes, field_label, h, notice, num } from '/ui/dom.js';
+
+const MAX_AUTO_BYTES = 64 * 1024 * 1024;  // larger snapshots load on request
 import { draw_particles } from '/ui/chart.js';
 import { component_names, field_values, parse_vtu } from '/ui/vtu.js';
 
@@ -30,11 +32,18 @@ export async function snapshot_panel(root, files, pvd_href, get_spec) {
   root.replaceChildren(h('div', { class: 'controls' }, pick, field, component, info), message, canvas);
 
   const cache = new Map();
+  const sizes_by_href = new Map(files.map((f) => [f.href, f.size]));
+  const allowed = new Set();
   let current = null;
 
   async function load() {
     const href = pick.value;
     message.replaceChildren();
+    if (sizes_by_href.get(href) > MAX_AUTO_BYTES && !allowed.has(href)) {
+      message.replaceChildren(notice('warn', `This snapshot is ${bytes(sizes_by_href.get(href))}: reading it may take a while. `),
+        h('button', { class: 'btn', type: 'button', onclick: () => { allowed.add(href); load(); } }, 'Load it'));
+      return;
+    }
     try {
       if (!cache.has(href)) cache.set(href, parse_vtu(await get_text(href)));
     } catch (err) {

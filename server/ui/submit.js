@@ -19,6 +19,7 @@ export function expected_seconds(doc) {
 }
 
 export function render(main) {
+  document.title = 'New job · hmpm';
   const examples = h('select', { id: 'example-select', 'aria-label': 'example' }, h('option', { value: '' }, 'Load an example…'));
   const file = h('input', { id: 'spec-file', type: 'file', accept: '.json,application/json', class: 'file-input' });
   const file_label = h('label', { class: 'btn', for: 'spec-file' }, 'Open file…');

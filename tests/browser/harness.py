@@ -102,6 +102,7 @@ def chromium(width=1360, height=900):
                 f"--window-size={width},{height}", "--force-device-scale-factor=1",
                 "--no-first-run", "--disable-extensions", "--disable-background-networking"):
         options.add_argument(arg)
+    options.set_capability("goog:loggingPrefs", {"browser": "ALL"})  # console errors, read by the tests
     driver = webdriver.Chrome(service=DriverService(os.environ.get("CHROMEDRIVER", "/usr/bin/chromedriver")), options=options)
     driver.set_page_load_timeout(30)
     driver.set_script_timeout(30)

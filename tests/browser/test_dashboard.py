@@ -71,6 +71,13 @@ class Dashboard(unittest.TestCase):
         if cls.service:
             cls.service.stop()
 
+    def tearDown(self):
+        # no script errors in the console (answers like 404 for a route the
+        # server does not have yet are expected and reported by the page)
+        errors = [e["message"] for e in self.driver.get_log("browser")
+                  if e["level"] == "SEVERE" and "Failed to load resource" not in e["message"]]
+        self.assertEqual(errors, [], "errors in the browser console")
+
     # --- HTTP helpers (the API directly, not through the page)
     @classmethod
     def call(cls, method, path, body=None):
