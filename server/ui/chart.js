@@ -103,7 +103,8 @@ export function colour(t) {
 // Draws particles (points: x y z per point, sizes: a length per point or
 // null) coloured by `values` on the canvas, with a colour bar on the right.
 // `bounds` ({min: [x, y], max: [x, y]}) fixes the view, e.g. to the grid.
-export function draw_particles(canvas, points, values, sizes, { bounds = null, label = '' } = {}) {
+// `range` ({vmin, vmax}) fixes the colour scale, e.g. across snapshots.
+export function draw_particles(canvas, points, values, sizes, { bounds = null, label = '', range = null } = {}) {
   const n = values.length;
   const bar_w = 86;
   const pad = 28;
@@ -156,6 +157,7 @@ export function draw_particles(canvas, points, values, sizes, { bounds = null, l
   let [vmin, vmax] = [Infinity, -Infinity];
   for (const v of values) if (Number.isFinite(v)) [vmin, vmax] = [Math.min(vmin, v), Math.max(vmax, v)];
   if (vmin === Infinity) [vmin, vmax] = [0, 1];
+  if (range) [vmin, vmax] = [range.vmin, range.vmax];
   const vspan = vmax - vmin || 1;
   for (let i = 0; i < n; ++i) {
     const r = Math.max(1.5, Math.min(20, sizes ? 0.5 * sizes[i] * scale : 3));

@@ -27,9 +27,21 @@ export async function snapshot_panel(root, files, pvd_href, get_spec) {
   const field = h('select', { id: 'snapshot-field', 'aria-label': 'field' });
   const component = h('select', { id: 'snapshot-component', 'aria-label': 'component' });
   const info = h('span', { class: 'muted small', id: 'snapshot-info' });
+  const step = (by) => {
+    const i = Math.max(0, Math.min(pick.options.length - 1, pick.selectedIndex + by));
+    if (i !== pick.selectedIndex) {
+      pick.selectedIndex = i;
+      load();
+    }
+  };
+  const previous = h('button', { class: 'btn', type: 'button', title: 'previous snapshot', onclick: () => step(-1) }, '◀');
+  const next = h('button', { class: 'btn', type: 'button', title: 'next snapshot', onclick: () => step(1) }, '▶');
+  const keep = h('input', { type: 'checkbox', id: 'snapshot-keep-range' });
+  const keep_label = h('label', { class: 'small', title: 'keep the colour range when changing snapshot' }, keep, ' keep range');
+  let kept = null;
   const canvas = h('canvas', { id: 'snapshot-canvas', class: 'particles' });
   const message = h('div');
-  root.replaceChildren(h('div', { class: 'controls' }, pick, field, component, info), message, canvas);
+  root.replaceChildren(h('div', { class: 'controls' }, previous, pick, next, field, component, keep_label, info), message, canvas);
 
   const cache = new Map();
   const sizes_by_href = new Map(files.map((f) => [f.href, f.size]));
@@ -81,7 +93,9 @@ export async function snapshot_panel(root, files, pvd_href, get_spec) {
     const values = field_values(f, Number(component.value));
     const label = field_label(f.name, component.hidden ? '' : component.selectedOptions[0].textContent);
     const grid = spec.grid && spec.grid.min && spec.grid.max ? spec.grid : null;
-    const result = draw_particles(canvas, current.points, values, sizes, { bounds: grid, label });
+    const range = keep.checked && kept && kept.label === label ? kept : null;
+    const result = draw_particles(canvas, current.points, values, sizes, { bounds: grid, label, range });
+    if (!range) kept = { label, vmin: result.vmin, vmax: result.vmax };
     canvas.dataset.drawn = result.drawn;
     info.textContent = `${current.count} particles · ${Number.isFinite(current.time) ? `t = ${num(current.time)} s · ` : ''}range ${num(result.vmin)} … ${num(result.vmax)}`;
   }
@@ -92,6 +106,7 @@ export async function snapshot_panel(root, files, pvd_href, get_spec) {
     draw();
   });
   component.addEventListener('change', draw);
+  keep.addEventListener('change', draw);
   let resize = null;
   window.addEventListener('resize', () => {
     clearTimeout(resize);

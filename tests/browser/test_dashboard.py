@@ -11,9 +11,11 @@ HMPM_SCREENSHOTS=1 writes docs/figures/dashboard-*.png. Every wait is
 bounded; everything stays on the loopback interface.
 """
 
-import copy
+import base64
 import json
 import os
+import re
+import struct
 import sys
 import unittest
 import urllib.request
@@ -174,8 +176,14 @@ class Dashboard(unittest.TestCase):
             item = self.css(f'#validation-errors li.problem[data-path="{path}"]')
             self.assertEqual(item.find_element(By.CSS_SELECTOR, ".path").text, path)
             self.assertIn(words, item.find_element(By.CSS_SELECTOR, ".problem-message").text)
-        line = self.css('#validation-errors li.problem[data-path="/materials/bar/youngs_modulus"] .line').text
-        self.assertRegex(line, r"^line \d+")
+        text = json.dumps(spec, indent=2)
+        expected = next(i for i, l in enumerate(text.splitlines(), 1) if '"youngs_modulus"' in l)
+        item = self.css('#validation-errors li.problem[data-path="/materials/bar/youngs_modulus"]')
+        self.assertEqual(item.find_element(By.CSS_SELECTOR, ".line").text, f"line {expected}")
+        item.find_element(By.CSS_SELECTOR, ".path").click()  # selects the member in the editor
+        selected = self.driver.execute_script(
+            "const t = document.getElementById('spec-text'); return t.value.slice(t.selectionStart, t.selectionEnd)")
+        self.assertEqual(selected, '"youngs_modulus": -1')
         self.screenshot("submit-errors")
         # submitting anyway: the server refuses and the page stays, errors shown
         self.driver.find_element(By.ID, "submit-job").click()
@@ -270,6 +278,15 @@ class Dashboard(unittest.TestCase):
         self.assertGreater(coloured, 2000, "particles and colour bar are drawn")
         info = self.driver.find_element(By.ID, "snapshot-info").text
         self.assertIn("400 particles", info)
+        # the previous snapshot, drawn in the colour range of the last one
+        self.driver.find_element(By.ID, "snapshot-keep-range").click()
+        last = self.driver.find_element(By.ID, "snapshot-file").get_attribute("value")
+        self.driver.find_element(By.CSS_SELECTOR, "button[title='previous snapshot']").click()
+        wait_until(lambda: self.driver.find_element(By.ID, "snapshot-info").text != info, UI_TIMEOUT_S, "the previous snapshot")
+        self.assertNotEqual(self.driver.find_element(By.ID, "snapshot-file").get_attribute("value"), last)
+        self.assertTrue(self.driver.find_element(By.ID, "snapshot-info").text.endswith(info.split("range ")[1]), "the kept range")
+        self.driver.find_element(By.CSS_SELECTOR, "button[title='next snapshot']").click()
+        wait_until(lambda: self.driver.find_element(By.ID, "snapshot-info").text == info, UI_TIMEOUT_S, "the last snapshot again")
         self.driver.execute_script("document.getElementById('snapshot').scrollIntoView()")
         if SCREENSHOTS:
             self.driver.execute_script("window.scrollTo(0, 0)")
@@ -296,6 +313,31 @@ class Dashboard(unittest.TestCase):
         # answers 404 and the page says that Delete is the way
         wait_until(lambda: self.css("#job-status .badge").text.lower() == "dismissed"
                    or "no separate cancel" in self.css("#action-message").text, UI_TIMEOUT_S, "the cancel outcome")
+
+    def test_vtu_reader_gives_the_values_of_the_file(self):
+        name = "snapshot_0003.vtu"
+        xml = urllib.request.urlopen(urllib.request.Request(
+            f"{self.service.url}/jobs/{self.jobs['collapse']}/results/{name}",
+            headers={"Authorization": f"Bearer {TOKEN}"} if TOKEN else {}), timeout=30).read().decode()
+        raw = base64.b64decode(re.search(r'Name="velocity"[^>]*format="binary">\s*([^<\s]+)', xml).group(1))
+        (count,) = struct.unpack_from("<Q", raw)
+        expected = struct.unpack_from(f"<{count // 8}d", raw, 8)
+        self.open("#/jobs")
+        ascii_doc = ('<VTKFile type="UnstructuredGrid" byte_order="LittleEndian"><UnstructuredGrid><Piece NumberOfPoints="2">'
+                     '<PointData><DataArray type="Float64" Name="p" format="ascii">1.5 -2e3</DataArray></PointData>'
+                     '<Points><DataArray type="Float64" NumberOfComponents="3" format="ascii">0 0 0 1 2 0</DataArray></Points>'
+                     '</Piece></UnstructuredGrid></VTKFile>')
+        got = self.driver.execute_async_script(
+            "const [xml, ascii, done] = arguments; import('/ui/vtu.js').then((m) => {"
+            "  const v = m.parse_vtu(xml), a = m.parse_vtu(ascii);"
+            "  done({count: v.count, velocity: Array.from(v.fields.find((f) => f.name === 'velocity').values),"
+            "        ascii: Array.from(a.fields[0].values), points: Array.from(a.points)});"
+            "}).catch((e) => done({error: String(e)}))", xml, ascii_doc)
+        self.assertNotIn("error", got)
+        self.assertEqual(got["count"], 400)
+        self.assertEqual(got["velocity"], list(expected))
+        self.assertEqual(got["ascii"], [1.5, -2000.0])
+        self.assertEqual(got["points"], [0, 0, 0, 1, 2, 0])
 
     def test_cancel_and_delete_ask_first(self):
         job_id = self.submit(example("geostatic"))
