@@ -17,6 +17,7 @@ packages=(
   valgrind                             # docs/performance.md instruction counts
   python3                              # clients and result checks
   python3-meshio python3-matplotlib python3-jsonschema python3-numpy
+  chromium chromium-driver python3-selenium  # tests/browser: the dashboard in headless Chromium
 )
 
 missing=()
