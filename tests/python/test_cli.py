@@ -155,6 +155,17 @@ class CliTest(LiveServerCase):
         self.assertEqual(r.returncode, 1)
         self.assertIn("no series.json", r.stderr)
 
+    def test_status_takes_the_8_characters_the_progress_bar_prints(self):
+        job_id = self.submit_and_wait(bar_spec())
+        r = self.cli("status", job_id[:8])
+        self.assertEqual(r.returncode, 0, r.stderr)
+        doc = json.loads(r.stdout)
+        self.assertEqual(doc["jobID"], job_id)
+        self.assertEqual(doc["warnings"], [])
+        r = self.cli("log", job_id[:8])
+        self.assertEqual(r.returncode, 0, r.stderr)
+        self.assertIn("successful after", r.stdout)
+
     def test_unknown_job_status(self):
         r = self.cli("status", "no-such-job")
         self.assertEqual(r.returncode, 1)
