@@ -232,7 +232,6 @@ void WorkerPool::run_one(const JobRecord& job, Running& running) {
   const Claim claim = claim_of(job);
   log_transition(job.id, JobStatus::running, {{"attempt", job.attempts}});
   const std::filesystem::path dir = job_dir(job.id);
-  std::error_code ec;
   remove_all_but_log(dir);  // leftovers of an interrupted attempt
   append_run_log(dir, "attempt " + std::to_string(job.attempts) + " started on " +
                           settings_.claimant.instance + ": " + std::to_string(job.cost.particles) +
@@ -306,9 +305,13 @@ void WorkerPool::run_one(const JobRecord& job, Running& running) {
     return;
   }
   if (running.cancel && outcome != JobStatus::successful) {  // shutdown: run it again next start
-    remove_all_but_log(dir);
     const ClaimState state = store_.requeue(claim);
-    if (state == ClaimState::dismissed) return end_dismissed(job, claim, {}, seconds);
+    if (state == ClaimState::dismissed) return end_dismissed(job, claim, result.files, seconds);
+    if (state == ClaimState::lost) {
+      log_line({{"event", "job"}, {"job", job.id}, {"claim", "lost"}, {"seconds", seconds}});
+      return;
+    }
+    remove_all_but_log(dir);
     append_run_log(dir, "stopped after " + short_number(seconds) +
                             " s: the server is shutting down; queued again");
     log_transition(job.id, JobStatus::accepted, {{"requeued", true}, {"seconds", seconds}});
