@@ -518,6 +518,12 @@ TEST_F(RoutesTest, StopRequeuesTheRunningJobAndTheNextStartFinishesIt) {
   const Json done = wait_final(id, 90);
   EXPECT_EQ(done.value("status", ""), "successful") << done.dump();
   EXPECT_EQ(done.value("attempts", 0), 1);
+  // One log across both runs: the stop, then the second run to its end.
+  const std::string log = client_->Get(("/jobs/" + id + "/log").c_str())->body;
+  const auto stopped = log.find("the server is shutting down; queued again");
+  ASSERT_NE(stopped, std::string::npos) << log;
+  EXPECT_NE(log.find("started", stopped), std::string::npos) << log;
+  EXPECT_NE(log.find("successful after", stopped), std::string::npos) << log;
 }
 
 // The heartbeat renews the lease of a running job: with a 0.3 s lease, the
