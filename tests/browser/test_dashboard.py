@@ -190,6 +190,11 @@ class Dashboard(unittest.TestCase):
         wait_until(lambda: "refused" in self.driver.find_element(By.ID, "validation-state").text, UI_TIMEOUT_S, "the refusal")
         self.assertTrue(self.driver.current_url.endswith("#/submit"))
         self.css('#validation-errors li.problem[data-path="/materials/bar/youngs_modulus"]')
+        # a spec from a file replaces the text and is checked
+        self.driver.find_element(By.ID, "spec-file").send_keys(str(REPO / "examples" / "geostatic.json"))
+        wait_until(lambda: json.loads(self.css("#spec-text").get_attribute("value") or "{}").get("name") == "geostatic",
+                   UI_TIMEOUT_S, "the file's text in the editor")
+        wait_until(lambda: not self.driver.find_elements(By.CSS_SELECTOR, "#validation-errors li.problem"), UI_TIMEOUT_S, "no errors")
         # JSON syntax errors are caught before the server is asked
         self.set_editor('{"name": "x",')
         wait_until(lambda: "not valid JSON" in self.css('#validation-errors li.problem[data-path=""]').text, UI_TIMEOUT_S, "the syntax error")
