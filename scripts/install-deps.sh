@@ -18,6 +18,7 @@ packages=(
   python3                              # clients and result checks
   python3-meshio python3-matplotlib python3-jsonschema python3-numpy
   python3-owslib                       # tests/python/test_ogc.py: OGC API – Processes client
+  chromium chromium-driver python3-selenium  # tests/browser: the dashboard in headless Chromium
 )
 
 missing=()

@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
 # One command from a fresh clone to a tested build: installs dependencies,
-# builds everything, runs every C++ test (ctest) and every Python test.
+# builds everything, runs every C++ test (ctest), every Python test and the
+# dashboard's browser tests (headless Chromium with Debian's chromium-driver
+# and python3-selenium, which install-deps.sh installs; about 25 s).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install-deps.sh
@@ -13,4 +15,7 @@ if [ -d tests/python ] && ls tests/python/test_*.py >/dev/null 2>&1; then
   HMPM_BUILD_DIR="$PWD/build" PYTHONPATH="$PWD/clients/python" \
     "$py" -m unittest discover -s tests/python -t . -v || status=1
 fi
+# Selenium is Debian's python3-selenium: the system interpreter, not a venv.
+/usr/bin/python3 tests/browser/check_embed.py || status=1
+HMPM_BUILD_DIR="$PWD/build" /usr/bin/python3 tests/browser/test_dashboard.py || status=1
 exit $status

@@ -3,10 +3,14 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <optional>
 #include <system_error>
 
 #include "digest.hpp"
 #include "job_log.hpp"
+#include "run_log.hpp"
 
 namespace hmpm::server {
 namespace {
@@ -33,7 +37,74 @@ std::string describe(const std::vector<hmpm::api::SpecError>& errors) {
   return text;
 }
 
+// `x` rounded down to a whole number.
+long whole(double x) {
+  return static_cast<long>(std::floor(x));
+}
+
+// `x` with 4 significant digits ("0.25", "1.234e+04").
+std::string short_number(double x) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.4g", x);
+  return text;
+}
+
+// Removes everything in `dir` but the job's log (it spans every attempt).
+void remove_all_but_log(const std::filesystem::path& dir) {
+  std::error_code ec;
+  for (const auto& entry : std::filesystem::directory_iterator(dir, ec)) {
+    if (entry.path().filename() != run_log_name) std::filesystem::remove_all(entry.path(), ec);
+  }
+}
+
+// Size, SHA-256 and media type of each of `names` in `dir`, appended to
+// `files`; the name of the first one that cannot be read back, if any.
+std::optional<std::string> record_files(const std::filesystem::path& dir,
+                                        const std::vector<std::string>& names,
+                                        std::vector<ResultFile>& files) {
+  std::optional<std::string> unreadable;
+  for (const std::string& name : names) {
+    const auto path = dir / name;
+    std::error_code ec;
+    const auto size = std::filesystem::file_size(path, ec);
+    auto sha = sha256_file_hex(path);
+    if (ec || !sha) {
+      if (!unreadable) unreadable = name;
+      continue;
+    }
+    files.push_back({name, static_cast<std::int64_t>(size), *sha, hmpm::api::media_type_for(name)});
+  }
+  return unreadable;
+}
+
 }  // namespace
+
+void WorkerPool::end_dismissed(const JobRecord& job, const Claim& claim,
+                               const std::vector<std::string>& written, double seconds) {
+  const std::filesystem::path dir = job_dir(job.id);
+  std::vector<ResultFile> files;
+  record_files(dir, written, files);
+  ClaimState state = ClaimState::lost;
+  try {
+    state = store_.keep_results(claim, files, seconds);
+  } catch (const std::exception& e) {
+    log_line({{"event", "store_error"}, {"job", job.id}, {"detail", e.what()}});
+  }
+  if (state == ClaimState::lost) {  // not ours any more: touch nothing
+    log_line({{"event", "job"}, {"job", job.id}, {"claim", "lost"}, {"seconds", seconds}});
+    return;
+  }
+  const bool kept = state == ClaimState::held;
+  std::error_code ec;
+  if (kept) {
+    append_run_log(dir, "cancelled after " + short_number(seconds) + " s wall; " +
+                            std::to_string(files.size()) + " result files kept");
+  } else {
+    std::filesystem::remove_all(dir, ec);  // deleted: the files go with it
+  }
+  metrics_.observe_job(seconds, JobStatus::dismissed);
+  log_transition(job.id, JobStatus::dismissed, {{"seconds", seconds}, {"files_kept", kept}});
+}
 
 WorkerPool::WorkerPool(JobStore& store, Metrics& metrics, WorkerSettings settings)
     : store_(store), metrics_(metrics), settings_(std::move(settings)) {}
@@ -77,12 +148,14 @@ void WorkerPool::notify() {
   wake_.notify_one();
 }
 
-bool WorkerPool::cancel(const std::string& id) {
-  std::lock_guard<std::mutex> lock(mutex_);
+bool WorkerPool::cancel(const std::string& id, double wait_s) {
+  std::unique_lock<std::mutex> lock(mutex_);
   const auto it = running_.find(id);
   if (it == running_.end()) return false;
   it->second->dismissed = true;
   it->second->cancel = true;
+  job_done_.wait_for(lock, std::chrono::duration<double>(wait_s),
+                     [&] { return running_.find(id) == running_.end(); });
   return true;
 }
 
@@ -146,8 +219,11 @@ void WorkerPool::work() {
       log_line({{"event", "worker_error"}, {"job", job->id}, {"detail", e.what()}});
     }
     --metrics_.busy_workers;
-    std::lock_guard<std::mutex> lock(mutex_);
-    running_.erase(job->id);
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      running_.erase(job->id);
+    }
+    job_done_.notify_all();
   }
 }
 
@@ -156,8 +232,11 @@ void WorkerPool::run_one(const JobRecord& job, Running& running) {
   const Claim claim = claim_of(job);
   log_transition(job.id, JobStatus::running, {{"attempt", job.attempts}});
   const std::filesystem::path dir = job_dir(job.id);
-  std::error_code ec;
-  std::filesystem::remove_all(dir, ec);  // leftovers of an interrupted attempt
+  remove_all_but_log(dir);  // leftovers of an interrupted attempt
+  append_run_log(dir, "attempt " + std::to_string(job.attempts) + " started on " +
+                          settings_.claimant.instance + ": " + std::to_string(job.cost.particles) +
+                          " particles, " + std::to_string(job.cost.steps) + " steps, " +
+                          std::to_string(settings_.threads_per_job) + " solver threads");
 
   JobStatus outcome = JobStatus::failed;
   std::string reason;
@@ -166,14 +245,26 @@ void WorkerPool::run_one(const JobRecord& job, Running& running) {
   if (!parsed.ok()) {
     reason = "the stored spec is no longer valid: " + describe(parsed.errors);
   } else {
+    for (const auto& w : parsed.job->warnings) {
+      append_run_log(dir,
+                     "warning: " + (w.path.empty() ? std::string("/") : w.path) + ": " + w.message);
+    }
     hmpm::RunOptions options;
     options.threads = settings_.threads_per_job;
     options.cancel = &running.cancel;
     options.wall_time_limit_s = settings_.wall_time_limit_s;
     options.progress_interval_s = settings_.progress_interval_s;
     auto last_write = SteadyClock::now() - std::chrono::hours(1);
+    ProgressLogPacer pacer;
     options.on_progress = [&](const hmpm::Progress& p) {
       const auto now = SteadyClock::now();
+      if (pacer.due(p.fraction, now)) {
+        append_run_log(dir, "progress " + std::to_string(whole(100.0 * p.fraction)) + " %: step " +
+                                std::to_string(p.step) + " of " + std::to_string(p.total_steps) +
+                                ", t = " + short_number(p.time) + " of " +
+                                short_number(p.end_time) + " s, " +
+                                short_number(seconds_since(t0)) + " s wall");
+      }
       if (now - last_write < std::chrono::duration<double>(0.5 * settings_.progress_interval_s))
         return;
       last_write = now;
@@ -210,29 +301,27 @@ void WorkerPool::run_one(const JobRecord& job, Running& running) {
     return;
   }
   if (running.dismissed) {
-    std::filesystem::remove_all(dir, ec);
-    metrics_.observe_job(seconds, JobStatus::dismissed);
-    log_transition(job.id, JobStatus::dismissed, {{"seconds", seconds}});
+    end_dismissed(job, claim, result.files, seconds);
     return;
   }
   if (running.cancel && outcome != JobStatus::successful) {  // shutdown: run it again next start
-    std::filesystem::remove_all(dir, ec);
-    store_.requeue(claim);
+    const ClaimState state = store_.requeue(claim);
+    if (state == ClaimState::dismissed) return end_dismissed(job, claim, result.files, seconds);
+    if (state == ClaimState::lost) {
+      log_line({{"event", "job"}, {"job", job.id}, {"claim", "lost"}, {"seconds", seconds}});
+      return;
+    }
+    remove_all_but_log(dir);
+    append_run_log(dir, "stopped after " + short_number(seconds) +
+                            " s: the server is shutting down; queued again");
     log_transition(job.id, JobStatus::accepted, {{"requeued", true}, {"seconds", seconds}});
     return;
   }
 
   std::vector<ResultFile> files;
-  for (const std::string& name : result.files) {
-    const auto path = dir / name;
-    const auto size = std::filesystem::file_size(path, ec);
-    auto sha = sha256_file_hex(path);
-    if (ec || !sha) {
-      outcome = JobStatus::failed;
-      reason = "result file " + name + " could not be read back";
-      continue;
-    }
-    files.push_back({name, static_cast<std::int64_t>(size), *sha, hmpm::api::media_type_for(name)});
+  if (const auto unreadable = record_files(dir, result.files, files)) {
+    outcome = JobStatus::failed;
+    reason = "result file " + *unreadable + " could not be read back";
   }
   const std::string message = outcome == JobStatus::successful ? "finished" : reason;
   const ClaimState state = store_.finish(claim, JobEnd{outcome, message, reason, files, seconds});
@@ -240,11 +329,10 @@ void WorkerPool::run_one(const JobRecord& job, Running& running) {
     log_line({{"event", "job"}, {"job", job.id}, {"claim", "lost"}, {"seconds", seconds}});
     return;
   }
-  if (state == ClaimState::dismissed) {
-    std::filesystem::remove_all(dir, ec);  // dismissed while finishing
-    log_transition(job.id, JobStatus::dismissed, {{"seconds", seconds}});
-    return;
-  }
+  if (state == ClaimState::dismissed) return end_dismissed(job, claim, result.files, seconds);
+  append_run_log(dir, std::string(status_name(outcome)) + " after " + short_number(seconds) +
+                          " s wall, " + std::to_string(files.size()) + " result files" +
+                          (reason.empty() ? "" : ": " + reason));
   metrics_.observe_job(seconds, outcome);
   nlohmann::ordered_json extra{{"seconds", seconds}, {"files", files.size()}};
   if (!reason.empty()) extra["reason"] = reason;

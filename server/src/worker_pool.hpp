@@ -7,8 +7,10 @@
 // solver work; they only nudge the pool (`notify`) or ask it to cancel.
 //
 // Cancellation is cooperative: each running job has an atomic flag the solver
-// checks once per step. A client's DELETE dismisses the job; a shutdown puts
-// it back in the queue so the next start resumes it.
+// checks once per step. A client's cancel or DELETE dismisses the job (the
+// store says whether its files stay: keep_results); a shutdown puts it back
+// in the queue so the next start resumes it. Each job's log (run_log.hpp) is
+// written here.
 //
 // Every job is claimed for this process's instance (`WorkerSettings::claimant`);
 // a heartbeat thread renews the leases of the running jobs every
@@ -54,9 +56,10 @@ class WorkerPool {
   void start();
   /// Wakes an idle worker: a job was queued.
   void notify();
-  /// Asks the worker running `id` to stop; its job stays dismissed. Returns
-  /// whether a worker of this process was running it.
-  bool cancel(const std::string& id);
+  /// Asks the worker running `id` to stop; its job stays dismissed. Waits up
+  /// to `wait_s` for the worker to let go of the job (its files recorded or
+  /// removed). Returns whether a worker of this process was running it.
+  bool cancel(const std::string& id, double wait_s = 0.0);
   /// Stops taking jobs, cancels the running ones, puts them back in the
   /// queue and joins the threads. Idempotent.
   void shutdown();
@@ -73,6 +76,10 @@ class WorkerPool {
   void work();
   void heartbeat();
   void run_one(const JobRecord& job, Running& running);
+  // The end of a dismissed run: keeps the files it `written` if the job was
+  // cancelled, removes them if it was deleted (the store decides).
+  void end_dismissed(const JobRecord& job, const Claim& claim,
+                     const std::vector<std::string>& written, double seconds);
 
   JobStore& store_;
   Metrics& metrics_;
@@ -80,6 +87,7 @@ class WorkerPool {
   std::mutex mutex_;
   std::condition_variable wake_;            ///< workers: a job was queued, or stop
   std::condition_variable heartbeat_wake_;  ///< the heartbeat thread: stop
+  std::condition_variable job_done_;        ///< a worker let go of a job
   bool stopping_ = false;
   std::uint64_t generation_ = 0;  ///< bumped by notify()
   std::map<std::string, std::shared_ptr<Running>> running_;

@@ -110,6 +110,62 @@ class CliTest(LiveServerCase):
         self.assertEqual(r.returncode, 3)
         self.assertIn("dismissed", r.stderr)
 
+    def test_cancel_of_a_finished_job_changes_nothing(self):
+        job_id = self.submit_and_wait(bar_spec())
+        job = Client(self.server.url).job(job_id)
+        before = {f["name"]: f["sha256"] for f in job.results()}
+        r = self.cli("cancel", job_id)
+        self.assertEqual(r.returncode, 1, r.stderr)
+        self.assertIn("already ended (successful)", r.stderr)
+        self.assertIn("nothing was changed", r.stderr)
+        self.assertEqual(job.status()["status"], "successful")
+        self.assertEqual({f["name"]: f["sha256"] for f in job.results()}, before)
+        r = self.cli("log", job_id)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        self.assertTrue(r.stdout.strip(), "the log of a finished job is empty")
+        r = self.cli("delete", job_id)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        self.assertIn("dismissed", r.stdout)
+
+    def test_list_shows_and_filters_names(self):
+        spec = bar_spec()
+        spec["name"] = "named-" + uuid.uuid4().hex[:8]
+        job_id = self.submit_and_wait(spec)
+        self.submit_and_wait(bar_spec())
+        r = self.cli("list", "--name", spec["name"])
+        self.assertEqual(r.returncode, 0, r.stderr)
+        lines = [l for l in r.stdout.splitlines() if l.strip()]
+        self.assertEqual(len(lines), 1, r.stdout)
+        self.assertIn(job_id, lines[0])
+        self.assertIn(spec["name"], lines[0])
+
+    @unittest.skipUnless(have_matplotlib(), "matplotlib is not installed (Debian: python3-matplotlib)")
+    def test_plot_a_local_result_folder(self):
+        job_id = self.submit_and_wait(column_spec())
+        out = self.tmp / "local"
+        r = self.cli("download", job_id, str(out))
+        self.assertEqual(r.returncode, 0, r.stderr)
+        png = self.tmp / "local.png"
+        # No service needed: an unreachable --url must not matter.
+        r = run_cli(["--url", "http://127.0.0.1:9", "plot", str(out), "--field", "pore_pressure",
+                     "--out", str(png)], timeout=60)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        self.assertEqual(png.read_bytes()[:8], b"\x89PNG\r\n\x1a\n")
+        r = run_cli(["plot", str(self.tmp), "--out", str(self.tmp / "none.png")], timeout=60)
+        self.assertEqual(r.returncode, 1)
+        self.assertIn("no series.json", r.stderr)
+
+    def test_status_takes_the_8_characters_the_progress_bar_prints(self):
+        job_id = self.submit_and_wait(bar_spec())
+        r = self.cli("status", job_id[:8])
+        self.assertEqual(r.returncode, 0, r.stderr)
+        doc = json.loads(r.stdout)
+        self.assertEqual(doc["jobID"], job_id)
+        self.assertEqual(doc["warnings"], [])
+        r = self.cli("log", job_id[:8])
+        self.assertEqual(r.returncode, 0, r.stderr)
+        self.assertIn("successful after", r.stdout)
+
     def test_unknown_job_status(self):
         r = self.cli("status", "no-such-job")
         self.assertEqual(r.returncode, 1)

@@ -120,6 +120,66 @@ TEST_P(StoreContract, DismissingARunningJobTurnsItsClaimedWritesIntoDismissed) {
   EXPECT_FALSE(store().dismiss("00000000-0000-4000-8000-000000000000"));
 }
 
+TEST_P(StoreContract, CancelKeepsTheFilesTheWorkerRecordsAndDeleteRemovesThem) {
+  const std::vector<ResultFile> files{
+      {"summary.json", 12, std::string(64, 'b'), "application/json"}};
+  // Queued: dismissed at once, no files.
+  const auto queued = store().submit(job("cq"), 10).job.id;
+  // Running: dismissed; the worker's claim may still record what it wrote.
+  const auto id = store().submit(job("c"), 10).job.id;
+  const auto claimed = store().claim_next(live());
+  ASSERT_EQ(claimed->id, queued);  // FIFO: the first one is claimed first
+  const Claim queued_claim = claim_of(*claimed);
+  EXPECT_EQ(store().cancel(queued)->status, JobStatus::running);
+  const Claim claim = claim_of(*store().claim_next(live()));
+  EXPECT_EQ(store().cancel(id)->status, JobStatus::running);
+  EXPECT_EQ(store().find(id)->status, JobStatus::dismissed);
+  EXPECT_FALSE(store().find(id)->results_deleted);
+  EXPECT_EQ(store().update_progress(claim, 50), ClaimState::dismissed);
+  EXPECT_EQ(store().keep_results(claim, files, 2.5), ClaimState::held);
+  ASSERT_EQ(store().results(id).size(), 1u);
+  // Ended: nothing changes, the row before comes back.
+  EXPECT_EQ(store().cancel(id)->status, JobStatus::dismissed);
+  EXPECT_EQ(store().results(id).size(), 1u);
+  EXPECT_FALSE(store().cancel("00000000-0000-4000-8000-000000000000"));
+  // A claim that is not the job's records nothing.
+  EXPECT_EQ(store().keep_results(Claim{id, "someone-else", claim.token}, files, 1),
+            ClaimState::lost);
+  // Delete after cancel: the files go, and a late worker is told so.
+  EXPECT_EQ(store().dismiss(queued)->status, JobStatus::dismissed);
+  EXPECT_TRUE(store().find(queued)->results_deleted);
+  EXPECT_EQ(store().keep_results(queued_claim, files, 1), ClaimState::dismissed);
+  EXPECT_TRUE(store().results(queued).empty());
+  store().dismiss(id);
+  EXPECT_TRUE(store().results(id).empty());
+  EXPECT_TRUE(store().find(id)->results_deleted);
+  // A finished job cannot be cancelled.
+  const auto done = store().submit(job("f"), 10).job.id;
+  const Claim done_claim = claim_of(*store().claim_next(live()));
+  store().finish(done_claim, JobEnd{JobStatus::successful, "finished", "", files, 1});
+  EXPECT_EQ(store().cancel(done)->status, JobStatus::successful);
+  EXPECT_EQ(store().find(done)->status, JobStatus::successful);
+  EXPECT_EQ(store().results(done).size(), 1u);
+}
+
+TEST_P(StoreContract, ListFiltersByNameAndIdsResolveFromPrefixes) {
+  const auto a = store().submit(job("alpha"), 10).job.id;
+  const auto b = store().submit(job("beta"), 10).job.id;
+  const auto a2 = store().submit(job("alpha"), 10).job.id;
+  const auto alphas = store().list({}, "alpha", 10);
+  ASSERT_EQ(alphas.size(), 2u);
+  EXPECT_EQ(alphas[0].id, a2);
+  EXPECT_EQ(alphas[1].id, a);
+  EXPECT_EQ(store().list({JobStatus::accepted}, "beta", 10).at(0).id, b);
+  EXPECT_TRUE(store().list({}, "gamma", 10).empty());
+  EXPECT_EQ(store().ids_with_prefix(a.substr(0, 8), 5), (std::vector<std::string>{a, b, a2}));
+  EXPECT_EQ(store().ids_with_prefix(b, 5), std::vector<std::string>{b});
+  EXPECT_EQ(store().ids_with_prefix("", 5).size(), 3u);
+  EXPECT_EQ(store().ids_with_prefix("", 2).size(), 2u);
+  EXPECT_TRUE(store().ids_with_prefix("zzzz", 5).empty());
+  EXPECT_TRUE(store().ids_with_prefix("%", 5).empty());  // matched as text, not a pattern
+}
+
 TEST_P(StoreContract, IdempotencyKeyReplaysSameBodyAndRejectsAnother) {
   const auto first = store().submit(job("i", "key-1", "hash-a"), 10);
   EXPECT_EQ(first.outcome, SubmitOutcome::created);
@@ -128,7 +188,7 @@ TEST_P(StoreContract, IdempotencyKeyReplaysSameBodyAndRejectsAnother) {
   EXPECT_EQ(again.job.id, first.job.id);
   const auto other = store().submit(job("i", "key-1", "hash-b"), 10);
   EXPECT_EQ(other.outcome, SubmitOutcome::key_conflict);
-  EXPECT_EQ(store().list({}, 10).size(), 1u);
+  EXPECT_EQ(store().list({}, "", 10).size(), 1u);
 }
 
 TEST_P(StoreContract, QueueCapCountsOnlyWaitingJobs) {
@@ -224,14 +284,14 @@ TEST_P(StoreContract, ListFiltersByStatusNewestFirst) {
   const auto b = store().submit(job("b"), 10).job.id;
   const auto c = store().submit(job("c"), 10).job.id;
   store().claim_next(live());  // a runs
-  const auto all = store().list({}, 10);
+  const auto all = store().list({}, "", 10);
   ASSERT_EQ(all.size(), 3u);
   EXPECT_EQ(all[0].id, c);
-  EXPECT_EQ(store().list({}, 2).size(), 2u);
-  const auto waiting = store().list({JobStatus::accepted}, 10);
+  EXPECT_EQ(store().list({}, "", 2).size(), 2u);
+  const auto waiting = store().list({JobStatus::accepted}, "", 10);
   ASSERT_EQ(waiting.size(), 2u);
   EXPECT_EQ(waiting[1].id, b);
-  EXPECT_EQ(store().list({JobStatus::running, JobStatus::failed}, 10).at(0).id, a);
+  EXPECT_EQ(store().list({JobStatus::running, JobStatus::failed}, "", 10).at(0).id, a);
 }
 
 TEST_P(StoreContract, EveryStatusOfTheTableIsStoredAndCounted) {
@@ -252,7 +312,7 @@ TEST_P(StoreContract, EveryStatusOfTheTableIsStoredAndCounted) {
   const auto counts = store().count_by_status();
   for (const auto& row : job_statuses) {
     EXPECT_EQ(counts.count(row.status) ? counts.at(row.status) : 0, 1) << row.name;
-    const auto listed = store().list({row.status}, 10);
+    const auto listed = store().list({row.status}, "", 10);
     ASSERT_EQ(listed.size(), 1u) << row.name;
     EXPECT_EQ(listed[0].name, row.name);
   }
@@ -273,7 +333,7 @@ TEST_P(StoreContract, ConcurrentWritersNeverFail) {
           j.id += std::to_string(100000000000 + t * 1000 + i);
           s.submit(j, 100000);
           if (auto claimed = s.claim_next(live())) s.update_progress(claim_of(*claimed), 1);
-          s.list({}, 5);
+          s.list({}, "", 5);
         } catch (const StoreFailure&) {
           ++failures;
         }
@@ -282,7 +342,7 @@ TEST_P(StoreContract, ConcurrentWritersNeverFail) {
   }
   for (auto& t : pool) t.join();
   EXPECT_EQ(failures, 0);
-  EXPECT_EQ(s.list({}, 1000).size(), static_cast<std::size_t>(threads * per_thread));
+  EXPECT_EQ(s.list({}, "", 1000).size(), static_cast<std::size_t>(threads * per_thread));
 }
 
 }  // namespace

@@ -270,8 +270,14 @@ TEST_F(OgcTest, ExecutionSharesIdempotencyAndTheQueueLimitWithPostJobs) {
 
 TEST_F(OgcTest, AFullQueueIs503AndTheTokenGuardsEveryOgcRoute) {
   start(/*max_queue=*/0, /*token=*/"s3cret");
-  for (const char* path : {"/", "/conformance", "/processes", "/processes/hmpm"})
+  for (const char* path : {"/conformance", "/processes", "/processes/hmpm"})
     EXPECT_EQ(problem(client_->Get(path), 401).first, "unauthorized") << path;
+  // The landing page holds links only and is open, so that a browser on a
+  // server with a token still reaches the dashboard through it.
+  auto landing = client_->Get("/", {{"Accept", "text/html"}});
+  ASSERT_TRUE(landing);
+  EXPECT_EQ(landing->status, 303);
+  EXPECT_EQ(landing->get_header_value("Location"), "/ui");
   const Json request{{"inputs", {{"spec", json_of(small_spec())}}}};
   EXPECT_EQ(problem(execute(request), 401).first, "unauthorized");
   auto res = execute(request, {{"Authorization", "Bearer s3cret"}});

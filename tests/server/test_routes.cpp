@@ -137,7 +137,7 @@ TEST_F(RoutesTest, SubmitPollAndDownloadResults) {
   EXPECT_GT(created["cost"]["particles"].get<int>(), 0);
   std::set<std::string> rels;
   for (const auto& l : created["links"]) rels.insert(l["rel"].get<std::string>());
-  EXPECT_EQ(rels, (std::set<std::string>{"self", "results", "events"}));
+  EXPECT_EQ(rels, (std::set<std::string>{"self", "results", "events", "log"}));
 
   auto stored = client_->Get(("/jobs/" + id + "/spec").c_str());
   ASSERT_TRUE(stored);
@@ -200,6 +200,9 @@ TEST_F(RoutesTest, SubmitReturnsTheSpecWarnings) {
             std::string::npos);
   const std::string id = created["jobID"];
   ASSERT_EQ(wait_final(id).value("status", ""), "successful");
+  // The status document carries them too, as in the 201.
+  const Json status = json_of(client_->Get(("/jobs/" + id).c_str())->body);
+  EXPECT_EQ(status["warnings"], created["warnings"]) << status.dump();
   auto summary = client_->Get(("/jobs/" + id + "/results/summary.json").c_str());
   ASSERT_TRUE(summary);
   ASSERT_EQ(summary->status, 200);
@@ -515,6 +518,12 @@ TEST_F(RoutesTest, StopRequeuesTheRunningJobAndTheNextStartFinishesIt) {
   const Json done = wait_final(id, 90);
   EXPECT_EQ(done.value("status", ""), "successful") << done.dump();
   EXPECT_EQ(done.value("attempts", 0), 1);
+  // One log across both runs: the stop, then the second run to its end.
+  const std::string log = client_->Get(("/jobs/" + id + "/log").c_str())->body;
+  const auto stopped = log.find("the server is shutting down; queued again");
+  ASSERT_NE(stopped, std::string::npos) << log;
+  EXPECT_NE(log.find("started", stopped), std::string::npos) << log;
+  EXPECT_NE(log.find("successful after", stopped), std::string::npos) << log;
 }
 
 // The heartbeat renews the lease of a running job: with a 0.3 s lease, the
@@ -554,6 +563,239 @@ TEST_F(RoutesTest, WallTimeLimitFailsTheJobWithAReason) {
   EXPECT_EQ(done.value("status", ""), "failed") << done.dump();
   EXPECT_FALSE(done.value("reason", "").empty()) << done.dump();
   EXPECT_FALSE(done.value("message", "").empty());
+}
+
+// --- Issue 19: the job lifecycle, logs, names, query parameters, id prefixes,
+// validation and the dashboard.
+
+TEST_F(RoutesTest, CancelStopsARunningJobAndKeepsWhatItWrote) {
+  start();
+  const std::string id = submit_running("to-cancel");
+  const std::string queued = submit(long_spec("queued", 10000));
+  auto res = client_->Post(("/jobs/" + id + "/cancel").c_str());
+  ASSERT_TRUE(res);
+  ASSERT_EQ(res->status, 202) << res->body;
+  EXPECT_EQ(json_of(res->body)["status"], "dismissed");
+  // The files it wrote stay downloadable: at least summary.json.
+  res = client_->Get(("/jobs/" + id + "/results").c_str());
+  ASSERT_TRUE(res);
+  ASSERT_EQ(res->status, 200) << res->body;
+  const Json manifest = json_of(res->body);
+  EXPECT_EQ(manifest["status"], "dismissed");
+  std::set<std::string> names;
+  for (const Json& f : manifest["files"]) names.insert(f["name"].get<std::string>());
+  ASSERT_TRUE(names.count("summary.json")) << res->body;
+  res = client_->Get(("/jobs/" + id + "/results/summary.json").c_str());
+  ASSERT_TRUE(res);
+  ASSERT_EQ(res->status, 200);
+  EXPECT_EQ(json_of(res->body)["status"], "dismissed") << res->body;  // the run's own word
+  // The worker moved on to the queued job; cancelling that one works while queued or running.
+  res = client_->Post(("/jobs/" + queued + "/cancel").c_str());
+  ASSERT_TRUE(res);
+  EXPECT_EQ(res->status, 202) << res->body;
+  EXPECT_EQ(json_of(client_->Get(("/jobs/" + queued).c_str())->body)["status"], "dismissed");
+  // Once ended: 409, nothing changes.
+  const Json again =
+      expect_problem(client_->Post(("/jobs/" + id + "/cancel").c_str()), 409, "job-finished");
+  EXPECT_EQ(again.value("jobStatus", ""), "dismissed");
+  EXPECT_EQ(json_of(client_->Get(("/jobs/" + id + "/results").c_str())->body)["files"],
+            manifest["files"]);
+  // DELETE still dismisses and deletes the results, also of a cancelled job.
+  EXPECT_EQ(client_->Delete(("/jobs/" + id).c_str())->status, 200);
+  expect_problem(client_->Get(("/jobs/" + id + "/results").c_str()), 410, "job-dismissed");
+  EXPECT_FALSE(std::filesystem::exists(service_->config().data_dir / id));
+}
+
+TEST_F(RoutesTest, CancellingAFinishedJobIs409AndChangesNothing) {
+  start();
+  const std::string id = submit(small_spec("done"));
+  ASSERT_EQ(wait_final(id).value("status", ""), "successful");
+  const std::string before = client_->Get(("/jobs/" + id + "/results").c_str())->body;
+  const Json problem =
+      expect_problem(client_->Post(("/jobs/" + id + "/cancel").c_str()), 409, "job-finished");
+  EXPECT_EQ(problem.value("jobStatus", ""), "successful");
+  EXPECT_EQ(problem.value("jobID", ""), id);
+  EXPECT_EQ(json_of(client_->Get(("/jobs/" + id).c_str())->body)["status"], "successful");
+  EXPECT_EQ(client_->Get(("/jobs/" + id + "/results").c_str())->body, before);
+  EXPECT_EQ(client_->Get(("/jobs/" + id + "/results/summary.json").c_str())->status, 200);
+  expect_problem(client_->Post("/jobs/00000000-0000-4000-8000-000000000000/cancel"), 404,
+                 "not-found");
+}
+
+TEST_F(RoutesTest, TheJobLogIsTextReadableWhileItRunsAndEndsWithTheOutcome) {
+  start();
+  const std::string id = submit_running("logged");
+  std::string log;
+  const auto deadline = Clock::now() + std::chrono::seconds(30);
+  do {  // progress lines: every 10 % or 10 s
+    auto res = client_->Get(("/jobs/" + id + "/log").c_str());
+    ASSERT_TRUE(res);
+    ASSERT_EQ(res->status, 200);
+    EXPECT_EQ(res->get_header_value("Content-Type").rfind("text/plain", 0), 0u);
+    log = res->body;
+    if (log.find("progress") != std::string::npos) break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  } while (Clock::now() < deadline);
+  EXPECT_NE(log.find("attempt 1 started"), std::string::npos) << log;
+  EXPECT_NE(log.find("progress 0 %"), std::string::npos) << log;
+  ASSERT_EQ(client_->Post(("/jobs/" + id + "/cancel").c_str())->status, 202);
+  log = client_->Get(("/jobs/" + id + "/log").c_str())->body;
+  EXPECT_NE(log.find("cancelled by the client while running"), std::string::npos) << log;
+  EXPECT_NE(log.find("result files kept"), std::string::npos) << log;
+
+  const std::string done = submit(small_spec("logged-done"));
+  ASSERT_EQ(wait_final(done).value("status", ""), "successful");
+  log = client_->Get(("/jobs/" + done + "/log").c_str())->body;
+  EXPECT_NE(log.find("progress 100 %"), std::string::npos) << log;
+  EXPECT_NE(log.find("successful after"), std::string::npos) << log;
+  // The log is not a result file.
+  EXPECT_EQ(client_->Get(("/jobs/" + done + "/results").c_str())->body.find("job.log"),
+            std::string::npos);
+}
+
+TEST_F(RoutesTest, ListItemsCarryNamesAndTheNameFilterSelects) {
+  start();
+  const std::string a = submit(small_spec("terzaghi"));
+  const std::string b = submit(small_spec("other"));
+  const std::string a2 = submit(small_spec("terzaghi"));
+  const Json all = json_of(client_->Get("/jobs")->body);
+  ASSERT_EQ(all["jobs"].size(), 3u);
+  EXPECT_EQ(all["jobs"][1]["name"], "other");
+  const Json named = json_of(client_->Get("/jobs?name=terzaghi")->body);
+  ASSERT_EQ(named["jobs"].size(), 2u) << named.dump();
+  EXPECT_EQ(named["jobs"][0]["jobID"], a2);
+  EXPECT_EQ(named["jobs"][1]["jobID"], a);
+  EXPECT_EQ(json_of(client_->Get("/jobs?name=nobody")->body)["jobs"].size(), 0u);
+  EXPECT_EQ(json_of(client_->Get("/jobs?name=other&status=accepted,running,successful")
+                        ->body)["jobs"][0]["jobID"],
+            b);
+}
+
+TEST_F(RoutesTest, UnknownQueryParametersAre400NamingTheAcceptedOnes) {
+  start();
+  const std::string id = submit(small_spec("q"));
+  Json p = expect_problem(client_->Get("/jobs?nmae=x"), 400, "invalid-parameter");
+  EXPECT_EQ(p["errors"][0]["path"], "nmae");
+  EXPECT_EQ(p["accepted"], Json::array({"status", "name", "limit"}));
+  EXPECT_NE(p.value("detail", "").find("status, name, limit"), std::string::npos);
+  p = expect_problem(client_->Get(("/jobs/" + id + "?verbose=1").c_str()), 400,
+                     "invalid-parameter");
+  EXPECT_EQ(p["accepted"], Json::array());
+  expect_problem(client_->Get("/health?x=1"), 400, "invalid-parameter");
+  expect_problem(client_->Post("/jobs?priority=high", small_spec(), "application/json"), 400,
+                 "invalid-parameter");
+  expect_problem(client_->Get(("/jobs/" + id + "/results?zip=1").c_str()), 400,
+                 "invalid-parameter");
+  EXPECT_EQ(json_of(client_->Get("/jobs")->body)["jobs"].size(), 1u);  // nothing was queued
+}
+
+TEST_F(RoutesTest, ShortIdPrefixesNameOneJobAndAmbiguousOnesAreRefused) {
+  // Two jobs whose ids share their first 8 characters, stored before the start.
+  {
+    std::filesystem::create_directories(config().db_path.parent_path());
+    auto store = open_sqlite_store(config().db_path);
+    for (const char* id :
+         {"abcdef01-0000-4000-8000-000000000001", "abcdef01-0000-4000-8000-000000000002"}) {
+      NewJob j;
+      j.id = id;
+      j.name = "twin";
+      j.spec = small_spec("twin");
+      ASSERT_EQ(store->submit(j, 10).outcome, SubmitOutcome::created);
+    }
+  }
+  start();
+  const std::string id = submit(small_spec("short"));
+  ASSERT_EQ(wait_final(id).value("status", ""), "successful");
+  for (const std::size_t n : {4u, 8u, 13u}) {
+    const std::string ref = id.substr(0, n);
+    auto res = client_->Get(("/jobs/" + ref).c_str());
+    ASSERT_TRUE(res);
+    ASSERT_EQ(res->status, 200) << ref << ": " << res->body;
+    EXPECT_EQ(json_of(res->body)["jobID"], id);
+  }
+  const std::string short_id = id.substr(0, 8);
+  EXPECT_EQ(client_->Get(("/jobs/" + short_id + "/results/summary.json").c_str())->status, 200);
+  EXPECT_EQ(client_->Get(("/jobs/" + short_id + "/log").c_str())->status, 200);
+  EXPECT_EQ(client_->Get(("/jobs/" + short_id + "/spec").c_str())->status, 200);
+  const Json p = expect_problem(client_->Get("/jobs/abcdef01"), 409, "ambiguous-id");
+  EXPECT_EQ(p["candidates"], Json::array({"abcdef01-0000-4000-8000-000000000001",
+                                          "abcdef01-0000-4000-8000-000000000002"}));
+  expect_problem(client_->Delete("/jobs/abcdef01"), 409, "ambiguous-id");
+  EXPECT_EQ(client_->Get("/jobs/abcdef01-0000-4000-8000-000000000002")->status, 200);
+  expect_problem(client_->Get("/jobs/0000"), 404, "not-found");
+  expect_problem(client_->Get("/jobs/abc"), 404, "not-found");  // fewer than 4 characters
+  EXPECT_EQ(client_->Delete(("/jobs/" + short_id).c_str())->status, 200);
+  EXPECT_EQ(json_of(client_->Get(("/jobs/" + id).c_str())->body)["status"], "dismissed");
+}
+
+TEST_F(RoutesTest, ValidateAnswersValidWithWarningsAndCostOrTheInvalidSpecProblem) {
+  start();
+  Json spec = json_of(small_spec("check", 0.05));
+  spec["materials"]["bar"]["density"] = 2000.0;
+  spec["materials"]["bar"]["hydraulic"] = {
+      {"porosity", 0.3}, {"hydraulic_conductivity", 1e-6}, {"fluid_bulk_modulus", 1.0}};
+  auto res = client_->Post("/validate", spec.dump(), "application/json");
+  ASSERT_TRUE(res);
+  ASSERT_EQ(res->status, 200) << res->body;
+  EXPECT_EQ(res->get_header_value("Content-Type"), "application/json");
+  Json doc = json_of(res->body);
+  EXPECT_EQ(doc["valid"], true);
+  ASSERT_EQ(doc["warnings"].size(), 1u);
+  EXPECT_EQ(doc["warnings"][0]["path"], "/materials/bar/hydraulic");
+  EXPECT_EQ(doc["cost"]["particles"], 13);
+  EXPECT_EQ(doc["cost"]["steps"], 50);
+  EXPECT_GT(doc["cost"]["dt"].get<double>(), 0.0);
+  res = client_->Post("/validate", small_spec("plain"), "application/json");
+  EXPECT_EQ(json_of(res->body)["warnings"], Json::array());
+  // The cost is the one the job gets.
+  const std::string id = submit(small_spec("plain"));
+  EXPECT_EQ(json_of(client_->Get(("/jobs/" + id).c_str())->body)["cost"],
+            json_of(res->body)["cost"]);
+
+  spec["materials"]["bar"]["youngs_modulus"] = -1;
+  Json p = expect_problem(client_->Post("/validate", spec.dump(), "application/json"), 400,
+                          "invalid-spec");
+  ASSERT_FALSE(p["errors"].empty());
+  EXPECT_EQ(p["errors"][0]["path"], "/materials/bar/youngs_modulus");
+  EXPECT_FALSE(p["errors"][0].value("message", "").empty());
+  p = expect_problem(client_->Post("/validate", "{not json", "application/json"), 400,
+                     "invalid-spec");
+  EXPECT_EQ(p["errors"][0]["path"], "");
+  EXPECT_EQ(json_of(client_->Get("/jobs")->body)["jobs"].size(), 1u);  // validate queues nothing
+}
+
+TEST_F(RoutesTest, TheDashboardIsServedWithoutATokenAndNotCached) {
+  ServiceConfig c = config();
+  c.token = "s3cret";
+  start(c);
+  for (const char* path : {"/ui", "/ui/", "/ui/index.html"}) {
+    auto res = client_->Get(path);
+    ASSERT_TRUE(res);
+    ASSERT_EQ(res->status, 200) << path;
+    EXPECT_EQ(res->get_header_value("Content-Type"), "text/html; charset=utf-8");
+    EXPECT_EQ(res->get_header_value("Cache-Control"), "no-cache");
+    EXPECT_EQ(res->body,
+              read_file(std::filesystem::path(HMPM_SOURCE_DIR) / "server/ui/index.html"));
+  }
+  auto res = client_->Get("/ui/app.js");
+  ASSERT_EQ(res->status, 200);
+  EXPECT_EQ(res->get_header_value("Content-Type"), "text/javascript; charset=utf-8");
+  res = client_->Get("/ui/style.css");
+  EXPECT_EQ(res->get_header_value("Content-Type"), "text/css; charset=utf-8");
+  res = client_->Get("/ui/examples/index.json");
+  ASSERT_EQ(res->status, 200);
+  const Json names = json_of(res->body);
+  ASSERT_TRUE(names.is_array());
+  ASSERT_FALSE(names.empty());
+  res = client_->Get(("/ui/examples/" + names[0].get<std::string>() + ".json").c_str());
+  ASSERT_EQ(res->status, 200);
+  EXPECT_EQ(res->get_header_value("Content-Type"), "application/json");
+  EXPECT_TRUE(json_of(res->body).is_object());
+  expect_problem(client_->Get("/ui/README.md"), 404, "not-found");
+  expect_problem(client_->Get("/ui/../db/hmpm.sqlite"), 404, "not-found");
+  // The API itself still needs the token.
+  expect_problem(client_->Get("/jobs"), 401, "unauthorized");
+  expect_problem(client_->Post("/validate", small_spec(), "application/json"), 401, "unauthorized");
 }
 
 }  // namespace

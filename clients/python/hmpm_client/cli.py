@@ -1,10 +1,14 @@
 """The `python3 -m hmpm_client` command line.
 
     python3 -m hmpm_client --url URL submit SPEC.json [--wait] [--download DIR]
-    python3 -m hmpm_client --url URL status ID | list [--status S] [--limit N]
-    python3 -m hmpm_client --url URL wait ID | results ID | download ID DIR
-    python3 -m hmpm_client --url URL cancel ID
-    python3 -m hmpm_client --url URL plot ID --field pore_pressure [--out FILE.png]
+    python3 -m hmpm_client --url URL status ID | list [--status S] [--name N] [--limit N]
+    python3 -m hmpm_client --url URL wait ID | results ID | download ID DIR | log ID
+    python3 -m hmpm_client --url URL cancel ID     # stop a queued/running job, keep its files
+    python3 -m hmpm_client --url URL delete ID     # dismiss a job and delete its files
+    python3 -m hmpm_client --url URL plot ID|DIR --field pore_pressure [--out FILE.png]
+
+`plot` takes a job id, or a local folder holding series.json (what
+`download` or `hmpm run --out` wrote), so no service is needed for it.
 
 Exit status: 0 success (for submit --wait and wait: the job succeeded);
 1 the service refused the request or could not be reached; 2 bad usage or a
@@ -64,10 +68,17 @@ def _parser() -> argparse.ArgumentParser:
     s = sub.add_parser("list", help="list jobs")
     s.add_argument("--status", metavar="S[,S...]",
                    help="only these states: accepted, running, successful, failed, dismissed")
+    s.add_argument("--name", help="only jobs of this name (the spec's \"name\")")
     s.add_argument("--limit", type=int)
     s.add_argument("--json", action="store_true", help="print the status documents as JSON")
 
-    s = sub.add_parser("cancel", help="cancel a running job and dismiss it")
+    s = sub.add_parser("cancel", help="stop a queued or running job (its files stay; a finished job is left as it is)")
+    s.add_argument("id")
+
+    s = sub.add_parser("delete", help="dismiss a job and delete its result files")
+    s.add_argument("id")
+
+    s = sub.add_parser("log", help="print a job's log")
     s.add_argument("id")
 
     s = sub.add_parser("results", help="list a finished job's result files")
@@ -78,7 +89,7 @@ def _parser() -> argparse.ArgumentParser:
     s.add_argument("dir")
 
     s = sub.add_parser("plot", help="plot the time histories of the series particles")
-    s.add_argument("id")
+    s.add_argument("id", metavar="ID|DIR", help="a job id, or a local result folder with series.json")
     s.add_argument("--field", default="pore_pressure", help="series field (default: pore_pressure)")
     s.add_argument("--out", metavar="FILE.png", help="output file (default: ID-FIELD.png)")
     return p
@@ -92,7 +103,9 @@ def _status_line(doc: Dict[str, Any]) -> str:
     progress = doc.get("progress")
     pct = f"{float(progress):3.0f}%" if isinstance(progress, (int, float)) else "  ?%"
     msg = str(doc.get("message") or "")
-    return f"{doc.get('jobID', '?')}  {str(doc.get('status', '?')):<10} {pct}  {doc.get('created', '')}  {msg}"
+    name = str(doc.get("name") or "-")
+    return (f"{doc.get('jobID', '?')}  {name:<20} {str(doc.get('status', '?')):<10} {pct}  "
+            f"{doc.get('created', '')}  {msg}")
 
 
 def _finish(job: Job, doc: Dict[str, Any]) -> int:
@@ -154,7 +167,7 @@ def cmd_wait(client: Client, args) -> int:
 
 
 def cmd_list(client: Client, args) -> int:
-    docs = client.jobs(status=args.status, limit=args.limit)
+    docs = client.jobs(status=args.status, limit=args.limit, name=args.name)
     if args.json:
         _print_json(docs)
     else:
@@ -164,8 +177,26 @@ def cmd_list(client: Client, args) -> int:
 
 
 def cmd_cancel(client: Client, args) -> int:
-    doc = client.job(args.id).cancel()
+    try:
+        doc = client.job(args.id).cancel()
+    except HmpmError as e:
+        if e.status == 409:
+            ended = (e.problem or {}).get("jobStatus") or "ended"
+            _err(f"job {args.id} had already ended ({ended}): nothing was changed, its results "
+                 f"are intact (to delete them: delete {args.id})")
+            return EXIT_ERROR
+        raise
     print(_status_line(doc))
+    return EXIT_OK
+
+
+def cmd_delete(client: Client, args) -> int:
+    print(_status_line(client.job(args.id).delete()))
+    return EXIT_OK
+
+
+def cmd_log(client: Client, args) -> int:
+    sys.stdout.write(client.job(args.id).log())
     return EXIT_OK
 
 
@@ -182,11 +213,21 @@ def cmd_download(client: Client, args) -> int:
 
 def cmd_plot(client: Client, args) -> int:
     from .plot import MatplotlibMissing, plot_series
-    job = client.job(args.id)
-    out = Path(args.out or f"{args.id}-{args.field}.png")
+    local = Path(args.id)
+    label = local.name if local.is_dir() else args.id
+    out = Path(args.out or f"{label}-{args.field}.png")
     try:
-        series = job.series()
-        plot_series(series, args.field, out, title=f"job {args.id}: {args.field}")
+        if local.is_dir():
+            path = local / "series.json"
+            if not path.is_file():
+                _err(f"{local}: no series.json in this folder (the spec's output.series was empty?)")
+                return EXIT_ERROR
+            series = json.loads(path.read_text())
+            title = f"{local}: {args.field}"
+        else:
+            series = client.job(args.id).series()
+            title = f"job {args.id}: {args.field}"
+        plot_series(series, args.field, out, title=title)
     except MatplotlibMissing as e:
         _err(str(e))
         return EXIT_NO_MATPLOTLIB
@@ -199,7 +240,7 @@ def cmd_plot(client: Client, args) -> int:
 
 COMMANDS = {
     "submit": cmd_submit, "status": cmd_status, "wait": cmd_wait, "list": cmd_list,
-    "cancel": cmd_cancel, "results": cmd_results, "download": cmd_download, "plot": cmd_plot,
+    "cancel": cmd_cancel, "delete": cmd_delete, "log": cmd_log, "results": cmd_results, "download": cmd_download, "plot": cmd_plot,
 }
 
 

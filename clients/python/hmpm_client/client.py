@@ -182,12 +182,15 @@ class Client:
         return Job(self, job_id)
 
     def jobs(self, status: Union[str, Sequence[str], None] = None,
-             limit: Optional[int] = None) -> List[Dict[str, Any]]:
+             limit: Optional[int] = None, name: Optional[str] = None) -> List[Dict[str, Any]]:
         """`GET /jobs`: status documents, newest first, of the given status
-        (one name, a comma-separated string or a list), at most `limit`."""
+        (one name, a comma-separated string or a list) and job `name`, at
+        most `limit`."""
         query = {}
         if status:
             query["status"] = status if isinstance(status, str) else ",".join(status)
+        if name:
+            query["name"] = name
         if limit is not None:
             query["limit"] = str(int(limit))
         path = "/jobs" + ("?" + urllib.parse.urlencode(query) if query else "")
@@ -262,12 +265,31 @@ class Job:
         return doc if isinstance(doc, dict) else {}
 
     def cancel(self) -> Dict[str, Any]:
-        """`DELETE /jobs/{id}`: cancels the job if it runs and dismisses it."""
+        """`POST /jobs/{id}/cancel`: stops a queued or running job (status
+        `dismissed`); whatever it wrote stays downloadable.
+
+        Raises HmpmError with status 409 (type `job-finished`) when the job
+        had already ended: nothing changes then, its results stay.
+        """
+        doc = self.client.request("POST", self.path + "/cancel")
+        if isinstance(doc, dict) and "status" in doc:
+            self.doc = doc
+            return doc
+        return self.status()
+
+    def delete(self) -> Dict[str, Any]:
+        """`DELETE /jobs/{id}`: dismisses the job (cancelling it if it runs)
+        and deletes its result files."""
         doc = self.client.request("DELETE", self.path)
         if isinstance(doc, dict) and "status" in doc:
             self.doc = doc
             return doc
         return self.status()
+
+    def log(self) -> str:
+        """`GET /jobs/{id}/log`: the job's log so far, as text."""
+        with self.client.open("GET", self.path + "/log", headers={"Accept": "text/plain"}) as resp:
+            return resp.read().decode("utf-8", errors="replace")
 
     # -- waiting ---------------------------------------------------------
 

@@ -21,6 +21,17 @@ Json link(const std::string& href, const char* rel, const char* type, const char
   return Json{{"href", href}, {"rel", rel}, {"type", type}, {"title", title}};
 }
 
+Json cost_document(const JobCost& cost) {
+  return Json{{"particles", cost.particles},
+              {"nodes", cost.nodes},
+              {"cells", cost.cells},
+              {"steps", cost.steps},
+              {"dt", cost.dt},
+              {"particle_steps", cost.particle_steps},
+              {"memory_bytes", cost.memory_bytes},
+              {"output_bytes", cost.output_bytes}};
+}
+
 Json status_document(const JobRecord& job) {
   const std::string self = "/jobs/" + job.id;
   Json doc{{"jobID", job.id},
@@ -36,19 +47,13 @@ Json status_document(const JobRecord& job) {
            {"updated", job.updated},
            {"attempts", job.attempts}};
   if (!job.failure_reason.empty()) doc["reason"] = job.failure_reason;
-  doc["cost"] = Json{{"particles", job.cost.particles},
-                     {"nodes", job.cost.nodes},
-                     {"cells", job.cost.cells},
-                     {"steps", job.cost.steps},
-                     {"dt", job.cost.dt},
-                     {"particle_steps", job.cost.particle_steps},
-                     {"memory_bytes", job.cost.memory_bytes},
-                     {"output_bytes", job.cost.output_bytes}};
+  doc["cost"] = cost_document(job.cost);
   if (job.run_seconds > 0) doc["run_seconds"] = job.run_seconds;
   doc["links"] = Json::array(
       {link(self, "self", "application/json", "this status document"),
        link(self + "/results", "results", "application/json", "manifest of the result files"),
-       link(self + "/events", "events", "text/event-stream", "progress as Server-Sent Events")});
+       link(self + "/events", "events", "text/event-stream", "progress as Server-Sent Events"),
+       link(self + "/log", "log", "text/plain", "the job's log")});
   return doc;
 }
 

@@ -18,6 +18,9 @@ int whole_percent(double progress);
 /// A link object {href, rel, type, title}.
 Json link(const std::string& href, const char* rel, const char* type, const char* title);
 
+/// The `cost` member of the status document (and of POST /validate).
+Json cost_document(const JobCost& cost);
+
 /// The status document of `job`.
 Json status_document(const JobRecord& job);
 

@@ -36,8 +36,9 @@ bool take_slot(Context& c) {
 }  // namespace
 
 void stream_events(Context& c, const httplib::Request& req, httplib::Response& res) {
-  const std::string id = req.matches[1];
-  if (!c.store.find(id)) return send_no_such_job(res, id);
+  const auto found = find_job(c, req.matches[1], res);
+  if (!found) return;
+  const std::string id = found->id;
   if (!take_slot(c)) {
     res.set_header("Retry-After", "5");
     return send_problem(res, 503, "too-many-streams", "Too many event streams",

@@ -1,12 +1,17 @@
-// jobs.cpp — POST/GET /jobs, GET/DELETE /jobs/{id}, GET /jobs/{id}/spec.
+// jobs.cpp — POST/GET /jobs, POST /validate, GET/DELETE /jobs/{id},
+// POST /jobs/{id}/cancel, GET /jobs/{id}/spec and /log.
 #include <charconv>
+#include <utility>
 #include <filesystem>
+#include <fstream>
+#include <sstream>
 
 #include "digest.hpp"
 #include "documents.hpp"
 #include "handlers.hpp"
 #include "job_log.hpp"
 #include "problem.hpp"
+#include "run_log.hpp"
 
 namespace hmpm::server::http {
 namespace {
@@ -33,7 +38,57 @@ Json spec_issues(const std::vector<hmpm::api::SpecError>& issues) {
   return out;
 }
 
+constexpr int max_candidates = 20;
+constexpr std::size_t full_id_length = 36;
+
+// How long POST /jobs/{id}/cancel waits for the worker to record the files.
+constexpr double cancel_wait_s = 5.0;
+
+// The 400 invalid-spec of POST /jobs and POST /validate.
+void send_invalid_spec(httplib::Response& res, const std::vector<hmpm::api::SpecError>& errors) {
+  const std::string detail = std::to_string(errors.size()) +
+                             (errors.size() == 1 ? " problem" : " problems") +
+                             " in the job spec; see errors";
+  send_problem(res, 400, "invalid-spec", "Invalid job spec", detail,
+               Json{{"errors", spec_issues(errors)}});
+}
+
+void log_dismissal(const std::string& id, JobStatus from, const char* how) {
+  log_line({{"event", "job"},
+            {"job", id},
+            {"status", status_name(JobStatus::dismissed)},
+            {"from", status_name(from)},
+            {"by", how}});
+}
+
 }  // namespace
+
+std::optional<JobRecord> find_job(Context& c, const std::string& ref, httplib::Response& res) {
+  if (ref.size() == full_id_length) {
+    auto job = c.store.find(ref);
+    if (!job) send_no_such_job(res, ref);
+    return job;
+  }
+  const std::vector<std::string> ids = c.store.ids_with_prefix(ref, max_candidates + 1);
+  if (ids.empty()) {
+    send_no_such_job(res, ref);
+    return std::nullopt;
+  }
+  if (ids.size() > 1) {
+    Json candidates = Json::array();
+    for (std::size_t i = 0; i < ids.size() && i < max_candidates; ++i) candidates.push_back(ids[i]);
+    send_problem(res, 409, "ambiguous-id", "Ambiguous job id",
+                 "'" + ref + "' is the start of " +
+                     (ids.size() > max_candidates ? "more than " + std::to_string(max_candidates)
+                                                  : std::to_string(ids.size())) +
+                     " job ids; give more of the id",
+                 Json{{"candidates", candidates}});
+    return std::nullopt;
+  }
+  auto job = c.store.find(ids.front());
+  if (!job) send_no_such_job(res, ref);  // deleted in between
+  return job;
+}
 
 void post_job(Context& c, const httplib::Request& req, httplib::Response& res,
               const std::string& body) {
@@ -54,13 +109,7 @@ void submit_job(Context& c, const httplib::Request& req, httplib::Response& res,
   }
 
   const hmpm::api::ParseResult parsed = hmpm::api::parse_job(spec, c.limits);
-  if (!parsed.ok() || !parsed.job) {
-    const std::string detail = std::to_string(parsed.errors.size()) +
-                               (parsed.errors.size() == 1 ? " problem" : " problems") +
-                               " in the job spec; see errors";
-    return send_problem(res, 400, "invalid-spec", "Invalid job spec", detail,
-                        Json{{"errors", spec_issues(parsed.errors)}});
-  }
+  if (!parsed.ok() || !parsed.job) return send_invalid_spec(res, parsed.errors);
 
   NewJob job;
   job.id = new_uuid_v4();
@@ -119,6 +168,7 @@ void list_jobs(Context& c, const httplib::Request& req, httplib::Response& res) 
       start = comma + 1;
     }
   }
+  const std::string name = req.get_param_value("name");
   int limit = 100;
   if (req.has_param("limit")) {
     const std::string v = req.get_param_value("limit");
@@ -128,8 +178,21 @@ void list_jobs(Context& c, const httplib::Request& req, httplib::Response& res) 
                                     "must be 1..1000");
     }
   }
+  // OGC API – Processes job-list filters: every job here is of process
+  // "hmpm" and of type "process", so they keep all jobs or none.
+  bool none = false;
+  for (const auto& [param, only] : {std::pair<const char*, const char*>{"processID", "hmpm"},
+                                    std::pair<const char*, const char*>{"type", "process"}}) {
+    for (std::size_t i = 0; i < req.get_param_value_count(param); ++i) {
+      std::string values = "," + req.get_param_value(param, i) + ",";
+      if (values.find(std::string(",") + only + ",") == std::string::npos) none = true;
+    }
+  }
   Json jobs = Json::array();
-  for (const JobRecord& job : c.store.list(statuses, limit)) jobs.push_back(status_document(job));
+  if (!none) {
+    for (const JobRecord& job : c.store.list(statuses, name, limit))
+      jobs.push_back(status_document(job));
+  }
   const auto n = jobs.size();
   send_json(res, 200,
             Json{{"jobs", std::move(jobs)},
@@ -137,34 +200,81 @@ void list_jobs(Context& c, const httplib::Request& req, httplib::Response& res) 
                  {"links", Json::array({link("/jobs", "self", "application/json", "job list")})}});
 }
 
+void validate_spec(Context& c, const httplib::Request&, httplib::Response& res,
+                   const std::string& body) {
+  const hmpm::api::ParseResult parsed = hmpm::api::parse_job(body, c.limits);
+  if (!parsed.ok() || !parsed.job) return send_invalid_spec(res, parsed.errors);
+  send_json(res, 200,
+            Json{{"valid", true},
+                 {"warnings", spec_issues(parsed.job->warnings)},
+                 {"cost", cost_document(cost_of(parsed.job->cost))}});
+}
+
 void get_job(Context& c, const httplib::Request& req, httplib::Response& res) {
-  const auto job = c.store.find(req.matches[1]);
-  if (!job) return send_no_such_job(res, req.matches[1]);
-  send_json(res, 200, status_document(*job));
+  const auto job = find_job(c, req.matches[1], res);
+  if (!job) return;
+  Json doc = status_document(*job);
+  // The spec's warnings, as in the 201: the stored spec parsed again (the
+  // same bytes give the same warnings), so the store keeps no copy of them.
+  const hmpm::api::ParseResult parsed = hmpm::api::parse_job(job->spec, c.limits);
+  doc["warnings"] = parsed.job ? spec_issues(parsed.job->warnings) : Json::array();
+  send_json(res, 200, doc);
 }
 
 void get_job_spec(Context& c, const httplib::Request& req, httplib::Response& res) {
-  const auto job = c.store.find(req.matches[1]);
-  if (!job) return send_no_such_job(res, req.matches[1]);
+  const auto job = find_job(c, req.matches[1], res);
+  if (!job) return;
   res.set_content(job->spec, "application/json");  // exactly the bytes submitted
 }
 
+void get_job_log(Context& c, const httplib::Request& req, httplib::Response& res) {
+  const auto job = find_job(c, req.matches[1], res);
+  if (!job) return;
+  if (job->results_deleted) {
+    return send_problem(res, 410, "job-dismissed", "Job dismissed",
+                        "the job was deleted; its log went with its results");
+  }
+  std::ifstream in(c.workers.job_dir(job->id) / run_log_name, std::ios::binary);
+  std::ostringstream text;
+  if (in) text << in.rdbuf();  // no file yet: the job has not started
+  res.set_content(text.str(), "text/plain; charset=utf-8");
+}
+
+void cancel_job(Context& c, const httplib::Request& req, httplib::Response& res) {
+  const auto job = find_job(c, req.matches[1], res);
+  if (!job) return;
+  const std::string& id = job->id;
+  const auto before = c.store.cancel(id);
+  if (!before) return send_no_such_job(res, id);
+  if (is_terminal(before->status)) {
+    return send_problem(res, 409, "job-finished", "Job already ended",
+                        std::string("the job has already ended (") + status_name(before->status) +
+                            "); nothing was changed",
+                        Json{{"jobID", id}, {"jobStatus", status_name(before->status)}});
+  }
+  append_run_log(c.workers.job_dir(id),
+                 std::string("cancelled by the client while ") + status_name(before->status));
+  log_dismissal(id, before->status, "cancel");
+  // A worker of this process records the files written so far; give it a
+  // moment so the manifest is complete when the client reads it.
+  if (before->status == JobStatus::running) c.workers.cancel(id, cancel_wait_s);
+  const auto after = c.store.find(id);
+  if (!after) return send_no_such_job(res, id);
+  send_json(res, 202, status_document(*after));
+}
+
 void dismiss_job(Context& c, const httplib::Request& req, httplib::Response& res) {
-  const std::string id = req.matches[1];
+  const auto job = find_job(c, req.matches[1], res);
+  if (!job) return;
+  const std::string& id = job->id;
   const auto before = c.store.dismiss(id);
   if (!before) return send_no_such_job(res, id);
-  if (before->status == JobStatus::running) {
-    c.workers.cancel(id);  // the worker removes its partial files
-  } else if (is_terminal(before->status) && before->status != JobStatus::dismissed) {
+  // A worker of this process removes the files itself once it has stopped.
+  if (!c.workers.cancel(id) && !before->results_deleted) {
     std::error_code ec;
     std::filesystem::remove_all(c.workers.job_dir(id), ec);
   }
-  if (before->status != JobStatus::dismissed) {
-    log_line({{"event", "job"},
-              {"job", id},
-              {"status", status_name(JobStatus::dismissed)},
-              {"from", status_name(before->status)}});
-  }
+  if (before->status != JobStatus::dismissed) log_dismissal(id, before->status, "delete");
   const auto after = c.store.find(id);
   if (!after) return send_no_such_job(res, id);
   send_json(res, 200, status_document(*after));

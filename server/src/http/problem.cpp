@@ -29,9 +29,11 @@ void send_no_such_job(httplib::Response& res, const std::string& id) {
 }
 
 void send_invalid_parameter(httplib::Response& res, const std::string& detail,
-                            const std::string& name, const std::string& message) {
-  send_problem(res, 400, "invalid-parameter", "Invalid parameter", detail,
-               Json{{"errors", Json::array({Json{{"path", name}, {"message", message}}})}});
+                            const std::string& name, const std::string& message,
+                            const Json& extra) {
+  Json members{{"errors", Json::array({Json{{"path", name}, {"message", message}}})}};
+  for (const auto& [key, value] : extra.items()) members[key] = value;
+  send_problem(res, 400, "invalid-parameter", "Invalid parameter", detail, members);
 }
 
 void send_too_large(httplib::Response& res, std::size_t limit_bytes) {

@@ -30,9 +30,10 @@ void send_not_found(httplib::Response& res, const std::string& what);
 /// 404 for a job id the store does not know.
 void send_no_such_job(httplib::Response& res, const std::string& id);
 
-/// 400 invalid-parameter for query parameter `name`.
+/// 400 invalid-parameter for query parameter `name`; members of `extra` appended.
 void send_invalid_parameter(httplib::Response& res, const std::string& detail,
-                            const std::string& name, const std::string& message);
+                            const std::string& name, const std::string& message,
+                            const Json& extra = Json::object());
 
 /// 413 payload-too-large naming the limit.
 void send_too_large(httplib::Response& res, std::size_t limit_bytes);

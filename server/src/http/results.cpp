@@ -14,16 +14,16 @@
 namespace hmpm::server::http {
 namespace {
 
-// A job whose results are asked for: nullopt (and the answer set) unless finished.
-std::optional<JobRecord> finished_job(Context& c, const std::string& id, httplib::Response& res) {
-  auto job = c.store.find(id);
-  if (!job) {
-    send_no_such_job(res, id);
-    return std::nullopt;
-  }
-  if (job->status == JobStatus::dismissed) {
+// A job whose results are asked for: nullopt (and the answer set) unless
+// finished. A cancelled job has finished with whatever it wrote; a deleted
+// one has none.
+std::optional<JobRecord> finished_job(Context& c, const std::string& ref, httplib::Response& res) {
+  auto job = find_job(c, ref, res);
+  if (!job) return std::nullopt;
+  const std::string& id = job->id;
+  if (job->results_deleted) {
     send_problem(res, 410, "job-dismissed", "Job dismissed",
-                 "the job was dismissed; its results are gone");
+                 "the job was deleted; its results are gone");
     return std::nullopt;
   }
   if (!is_terminal(job->status)) {

@@ -1,6 +1,7 @@
 // routes.cpp — the route table of hmpm-server and the router that serves it.
 #include "routes.hpp"
 
+#include <algorithm>
 #include <array>
 #include <stdexcept>
 
@@ -10,7 +11,9 @@
 namespace hmpm::server::http {
 namespace {
 
-const std::string job = "/jobs/([0-9a-f]{8}-[0-9a-f]{4}-[0-9a-f]{4}-[0-9a-f]{4}-[0-9a-f]{12})";
+// A job id, or a prefix of one (at least 4 hex digits): handlers resolve it
+// with find_job (jobs.cpp).
+const std::string job = "/jobs/([0-9a-f]{4}[0-9a-f-]{0,32})";
 
 constexpr std::array<Method, 5> all_methods{Method::get, Method::post, Method::put, Method::patch,
                                             Method::del};
@@ -22,15 +25,19 @@ std::vector<Route> route_table() {
       {Method::get, "/health", Access::open, get_health},
       {Method::get, "/metrics", Access::token, get_metrics},
       {Method::post, "/jobs", Access::token, post_job},
-      {Method::get, "/jobs", Access::token, list_jobs},
+      {Method::get, "/jobs", Access::token, list_jobs, {"status", "name", "limit", "processID", "type"}},
+      {Method::post, "/validate", Access::token, validate_spec},
       {Method::get, job, Access::token, get_job},
       {Method::del, job, Access::token, dismiss_job},
+      {Method::post, job + "/cancel", Access::token, cancel_job},
       {Method::get, job + "/spec", Access::token, get_job_spec},
+      {Method::get, job + "/log", Access::token, get_job_log},
       {Method::get, job + "/results", Access::token, get_manifest},
       {Method::get, job + "/results/(.+)", Access::token, get_result_file},
       {Method::get, job + "/events", Access::token, stream_events},
+      {Method::get, "/ui(/.*)?", Access::open, get_ui},
       // OGC API – Processes (ogc.cpp); its jobs are the /jobs routes above.
-      {Method::get, "/", Access::token, get_landing_page},
+      {Method::get, "/", Access::open, get_landing_page}  // links only; a browser goes on to /ui,
       {Method::get, "/conformance", Access::token, get_conformance},
       {Method::get, "/processes", Access::token, list_processes},
       {Method::get, "/processes/([^/]+)", Access::token, get_process},
@@ -90,6 +97,21 @@ void Router::answer_unrouted(const httplib::Request& req, httplib::Response& res
                req.method + " is not supported on " + req.path);
 }
 
+bool Router::query_accepted(const Route& route, const httplib::Request& req,
+                            httplib::Response& res) {
+  for (const auto& [name, value] : req.params) {
+    if (std::find(route.query.begin(), route.query.end(), name) != route.query.end()) continue;
+    std::string accepted;
+    for (const std::string& q : route.query) accepted += (accepted.empty() ? "" : ", ") + q;
+    const std::string detail =
+        "unknown query parameter '" + name + "': " + req.method + " " + req.path +
+        (accepted.empty() ? " takes no query parameters" : " accepts " + accepted);
+    send_invalid_parameter(res, detail, name, "unknown parameter", Json{{"accepted", route.query}});
+    return false;
+  }
+  return true;
+}
+
 namespace {
 
 using PlainRegistrar = httplib::Server& (httplib::Server::*)(const std::string&,
@@ -120,9 +142,10 @@ void Router::register_route(httplib::Server& server, const Compiled& c) const {
   if (const auto* plain = std::get_if<Handler>(&route.handler)) {
     (server.*plain_registrar(route.method))(
         route.pattern,
-        [this, guarded, f = *plain](const httplib::Request& req, httplib::Response& res) {
+        [this, &route, guarded, f = *plain](const httplib::Request& req, httplib::Response& res) {
           // Requests with a body skipped the pre-routing check; check here.
           if (guarded && !auth_.authorized(req)) return auth_.refuse(res);
+          if (!query_accepted(route, req, res)) return;
           f(context_, req, res);
         });
     return;
@@ -133,28 +156,30 @@ void Router::register_route(httplib::Server& server, const Compiled& c) const {
   const BodyRegistrar registrar = body_registrar(route.method);
   if (!registrar)
     throw std::logic_error("route " + route.pattern + ": GET and DELETE take no body");
-  (server.*registrar)(route.pattern, [this, guarded, f = std::get<BodyHandler>(route.handler)](
-                                         const httplib::Request& req, httplib::Response& res,
-                                         const httplib::ContentReader& reader) {
-    const std::size_t limit = context_.config.max_body_bytes;
-    std::string body;
-    bool too_large = false;
-    const bool complete = reader([&](const char* data, std::size_t n) {
-      if (body.size() + n > limit) {
-        too_large = true;
-        return false;
-      }
-      body.append(data, n);
-      return true;
-    });
-    if (!complete) {
-      if (too_large || res.status == 413) return send_too_large(res, limit);
-      return send_problem(res, 400, "bad-request", "Bad request",
-                          "the request body could not be read");
-    }
-    if (guarded && !auth_.authorized(req)) return auth_.refuse(res);
-    f(context_, req, res, body);
-  });
+  (server.*registrar)(route.pattern,
+                      [this, &route, guarded, f = std::get<BodyHandler>(route.handler)](
+                          const httplib::Request& req, httplib::Response& res,
+                          const httplib::ContentReader& reader) {
+                        const std::size_t limit = context_.config.max_body_bytes;
+                        std::string body;
+                        bool too_large = false;
+                        const bool complete = reader([&](const char* data, std::size_t n) {
+                          if (body.size() + n > limit) {
+                            too_large = true;
+                            return false;
+                          }
+                          body.append(data, n);
+                          return true;
+                        });
+                        if (!complete) {
+                          if (too_large || res.status == 413) return send_too_large(res, limit);
+                          return send_problem(res, 400, "bad-request", "Bad request",
+                                              "the request body could not be read");
+                        }
+                        if (guarded && !auth_.authorized(req)) return auth_.refuse(res);
+                        if (!query_accepted(route, req, res)) return;
+                        f(context_, req, res, body);
+                      });
 }
 
 void Router::install(httplib::Server& server) const {

@@ -1,16 +1,19 @@
 // routes.hpp — the one route table and the router built from it.
 //
 // Each row says method, path pattern (ECMAScript regex, whole path), whether
-// the Bearer token is needed, and the handler. Registration with cpp-httplib,
-// the 404/405 answers, the `Allow` header and the pre-routing token check all
-// read this table; nothing else lists paths or methods. To add an endpoint:
-// a row in routes.cpp and a handler in the resource's file (handlers.hpp).
+// the Bearer token is needed, the handler and the query parameters the route
+// accepts. Registration with cpp-httplib, the 404/405 answers, the `Allow`
+// header, the pre-routing token check and the 400 for an unknown query
+// parameter all read this table; nothing else lists paths, methods or
+// parameters. To add an endpoint: a row in routes.cpp and a handler in the
+// resource's file (handlers.hpp).
 #pragma once
 
 #include <httplib.h>
 
 #include <regex>
 #include <string>
+#include <utility>
 #include <variant>
 #include <vector>
 
@@ -34,10 +37,21 @@ using BodyHandler = void (*)(Context&, const httplib::Request&, httplib::Respons
                              const std::string& body);
 
 struct Route {
+  Route(Method method, std::string pattern, Access access,
+        std::variant<Handler, BodyHandler> handler, std::vector<std::string> query = {})
+      : method(method),
+        pattern(std::move(pattern)),
+        access(access),
+        handler(handler),
+        query(std::move(query)) {}
+
   Method method;
   std::string pattern;
   Access access;
   std::variant<Handler, BodyHandler> handler;
+  /// The query parameters the handler reads; any other one is a 400
+  /// invalid-parameter naming it and these (none listed: none accepted).
+  std::vector<std::string> query;
 };
 
 /// Every route of hmpm-server (routes.cpp).
@@ -65,6 +79,10 @@ class Router {
   };
   void register_route(httplib::Server& server, const Compiled& c) const;
   void answer_unrouted(const httplib::Request& req, httplib::Response& res) const;
+  /// Answers 400 and returns false when `req` has a query parameter `route`
+  /// does not accept.
+  static bool query_accepted(const Route& route, const httplib::Request& req,
+                             httplib::Response& res);
 
   std::vector<Compiled> routes_;
   Context& context_;

@@ -58,8 +58,8 @@ void configure_server(httplib::Server& http, Context& context, const Router& rou
     if (req.has_header("Transfer-Encoding") || (body_method && !req.has_header("Content-Length"))) {
       res.set_header("Connection", "close");
       send_problem(res, 411, "length-required", "Length required",
-                   "send the body with a Content-Length header; chunked or unterminated bodies "
-                   "are not accepted");
+                   "send the body with a Content-Length header (Content-Length: 0 when there is "
+                   "none, e.g. curl -d ''); chunked or unterminated bodies are not accepted");
       return httplib::Server::HandlerResponse::Handled;
     }
     if (req.has_header("Content-Length") && !content_length(req)) {

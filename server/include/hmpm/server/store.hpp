@@ -75,6 +75,9 @@ struct JobRecord {
   std::string owner;                  ///< instance id of the server running it
   std::int64_t lease_token = 0;       ///< fencing token, raised by every claim
   std::int64_t lease_expires_ms = 0;  ///< Unix time in ms; the claim lapses after it
+  /// Dismissed by deletion (DELETE): its files are gone. A job dismissed by
+  /// cancellation keeps whatever it wrote (false).
+  bool results_deleted = false;
 };
 
 /// A result file of a finished job: `<data-dir>/<job id>/<name>`.
@@ -163,8 +166,13 @@ class JobStore {
 
   virtual std::optional<JobRecord> find(const std::string& id) = 0;
 
-  /// Newest first; `statuses` empty means all.
-  virtual std::vector<JobRecord> list(const std::vector<JobStatus>& statuses, int limit) = 0;
+  /// Newest first; `statuses` empty means all, `name` empty any name.
+  virtual std::vector<JobRecord> list(const std::vector<JobStatus>& statuses,
+                                      const std::string& name, int limit) = 0;
+
+  /// The ids that start with `prefix` (lowercase hex and '-'), at most
+  /// `limit` of them, in submission order.
+  virtual std::vector<std::string> ids_with_prefix(const std::string& prefix, int limit) = 0;
 
   /// Takes the oldest accepted job for `who`: status running, attempts + 1,
   /// started now, owner = who.instance, lease until now + who.lease_s, a new
@@ -186,10 +194,23 @@ class JobStore {
   /// is not counted: the job did nothing wrong.
   virtual ClaimState requeue(const Claim& claim) = 0;
 
-  /// Dismisses a job in any state and forgets its result files. Returns the
-  /// row as it was before (nullopt for an unknown id); already dismissed
-  /// jobs stay as they are.
+  /// Cancels an accepted or running job: status dismissed, its result files
+  /// kept (a running job's worker records them with keep_results). A job that
+  /// has ended (successful, failed, dismissed) is left as it is. Returns the
+  /// row as it was before; nullopt for an unknown id.
+  virtual std::optional<JobRecord> cancel(const std::string& id) = 0;
+
+  /// Dismisses a job in any state and forgets its result files (also those a
+  /// cancelled job kept): results_deleted. Returns the row as it was before
+  /// (nullopt for an unknown id); a deleted job stays as it is.
   virtual std::optional<JobRecord> dismiss(const std::string& id) = 0;
+
+  /// Records the files a cancelled job wrote before its worker stopped.
+  /// held: recorded; dismissed: the job was deleted meanwhile (remove the
+  /// files); lost: another claim replaced this one, or the job was not
+  /// cancelled (touch nothing).
+  virtual ClaimState keep_results(const Claim& claim, const std::vector<ResultFile>& files,
+                                  double run_seconds) = 0;
 
   virtual std::vector<ResultFile> results(const std::string& id) = 0;
 

@@ -34,7 +34,7 @@ constexpr const char* job_columns =
     "id, seq, name, spec, status, progress, message, created, started, finished, updated, "
     "attempts, failure_reason, cost_particles, cost_nodes, cost_cells, cost_steps, "
     "cost_particle_steps, cost_memory_bytes, cost_output_bytes, cost_dt, run_seconds, "
-    "coalesce(owner, ''), lease_token, lease_expires_ms";
+    "coalesce(owner, ''), lease_token, lease_expires_ms, results_deleted";
 
 JobRecord read_job(const Statement& s) {
   JobRecord r;
@@ -63,6 +63,7 @@ JobRecord read_job(const Statement& s) {
   r.owner = s.text(22);
   r.lease_token = s.integer(23);
   r.lease_expires_ms = s.integer(24);
+  r.results_deleted = s.integer(25) != 0;
   return r;
 }
 
@@ -85,6 +86,22 @@ void bind_claim(Statement& s, const Claim& claim) {
 ClaimState claim_state(sqlite3* db, const Claim& claim) {
   const auto job = select_job(db, claim.job_id);
   return job && job->status == JobStatus::dismissed ? ClaimState::dismissed : ClaimState::lost;
+}
+
+void clear_results(sqlite3* db, const std::string& id) {
+  Statement clear(db, "DELETE FROM results WHERE job_id = ?1");
+  clear.bind(1, id);
+  clear.step();
+}
+
+void insert_results(sqlite3* db, const std::string& id, const std::vector<ResultFile>& files) {
+  for (const ResultFile& f : files) {
+    Statement s(
+        db,
+        "INSERT INTO results (job_id, name, size, sha256, media_type) VALUES (?1, ?2, ?3, ?4, ?5)");
+    s.bind(1, id).bind(2, f.name).bind(3, f.size).bind(4, f.sha256).bind(5, f.media_type);
+    s.step();
+  }
 }
 
 }  // namespace
@@ -156,10 +173,12 @@ std::optional<JobRecord> SqliteStore::find(const std::string& id) {
   return select_job(db.get(), id);
 }
 
-std::vector<JobRecord> SqliteStore::list(const std::vector<JobStatus>& statuses, int limit) {
-  std::string sql = std::string("SELECT ") + job_columns + " FROM jobs";
+std::vector<JobRecord> SqliteStore::list(const std::vector<JobStatus>& statuses,
+                                         const std::string& name, int limit) {
+  std::string sql =
+      std::string("SELECT ") + job_columns + " FROM jobs WHERE (?2 = '' OR name = ?2)";
   if (!statuses.empty()) {
-    sql += " WHERE status IN (";
+    sql += " AND status IN (";
     for (std::size_t i = 0; i < statuses.size(); ++i) {
       if (i > 0) sql += ",";
       sql += sql_name(statuses[i]);
@@ -169,9 +188,20 @@ std::vector<JobRecord> SqliteStore::list(const std::vector<JobStatus>& statuses,
   sql += " ORDER BY seq DESC LIMIT ?1";
   auto db = pool_.lease();
   Statement s(db.get(), sql);
-  s.bind(1, static_cast<std::int64_t>(limit));
+  s.bind(1, static_cast<std::int64_t>(limit)).bind(2, name);
   std::vector<JobRecord> out;
   while (s.step()) out.push_back(read_job(s));
+  return out;
+}
+
+std::vector<std::string> SqliteStore::ids_with_prefix(const std::string& prefix, int limit) {
+  auto db = pool_.lease();
+  // substr, not LIKE/GLOB: the prefix is matched as text, whatever it holds.
+  Statement s(db.get(),
+              "SELECT id FROM jobs WHERE substr(id, 1, length(?1)) = ?1 ORDER BY seq LIMIT ?2");
+  s.bind(1, prefix).bind(2, static_cast<std::int64_t>(limit));
+  std::vector<std::string> out;
+  while (s.step()) out.push_back(s.text(0));
   return out;
 }
 
@@ -241,18 +271,8 @@ ClaimState SqliteStore::finish(const Claim& claim, const JobEnd& end) {
     s.step();
     if (sqlite3_changes(db) != 1) return claim_state(db, claim);
   }
-  {
-    Statement clear(db, "DELETE FROM results WHERE job_id = ?1");
-    clear.bind(1, claim.job_id);
-    clear.step();
-  }
-  for (const ResultFile& f : end.files) {
-    Statement s(
-        db,
-        "INSERT INTO results (job_id, name, size, sha256, media_type) VALUES (?1, ?2, ?3, ?4, ?5)");
-    s.bind(1, claim.job_id).bind(2, f.name).bind(3, f.size).bind(4, f.sha256).bind(5, f.media_type);
-    s.step();
-  }
+  clear_results(db, claim.job_id);
+  insert_results(db, claim.job_id, end.files);
   tx.commit();
   return ClaimState::held;
 }
@@ -274,24 +294,61 @@ ClaimState SqliteStore::requeue(const Claim& claim) {
   return state;
 }
 
+std::optional<JobRecord> SqliteStore::cancel(const std::string& id) {
+  auto connection = pool_.lease();
+  sqlite3* db = connection.get();
+  WriteTransaction tx(db);
+  auto before = select_job(db, id);
+  if (!before || is_terminal(before->status)) return before;
+  Statement s(db, "UPDATE jobs SET status = " + sql_name(JobStatus::dismissed) +
+                      ", message = 'cancelled by the client', finished = ?1, updated = ?1 "
+                      "WHERE id = ?2");
+  s.bind(1, now_rfc3339()).bind(2, id);
+  s.step();
+  tx.commit();
+  return before;
+}
+
 std::optional<JobRecord> SqliteStore::dismiss(const std::string& id) {
   auto connection = pool_.lease();
   sqlite3* db = connection.get();
   WriteTransaction tx(db);
   auto before = select_job(db, id);
-  if (!before || before->status == JobStatus::dismissed) return before;
+  if (!before || before->results_deleted) return before;
   {
+    const bool was_dismissed = before->status == JobStatus::dismissed;
     Statement s(db, "UPDATE jobs SET status = " + sql_name(JobStatus::dismissed) +
-                        ", message = 'dismissed by the client', "
+                        ", message = ?3, results_deleted = 1, "
                         "finished = coalesce(finished, ?1), updated = ?1 WHERE id = ?2");
     s.bind(1, now_rfc3339()).bind(2, id);
+    s.bind(3, was_dismissed ? before->message + "; results deleted" : "dismissed by the client");
     s.step();
   }
-  Statement clear(db, "DELETE FROM results WHERE job_id = ?1");
-  clear.bind(1, id);
-  clear.step();
+  clear_results(db, id);
   tx.commit();
   return before;
+}
+
+ClaimState SqliteStore::keep_results(const Claim& claim, const std::vector<ResultFile>& files,
+                                     double run_seconds) {
+  auto connection = pool_.lease();
+  sqlite3* db = connection.get();
+  WriteTransaction tx(db);
+  const auto job = select_job(db, claim.job_id);
+  if (!job || job->owner != claim.owner || job->lease_token != claim.token ||
+      job->status != JobStatus::dismissed) {
+    return ClaimState::lost;
+  }
+  if (job->results_deleted) return ClaimState::dismissed;
+  {
+    Statement s(db, "UPDATE jobs SET run_seconds = ?2, updated = ?3 WHERE id = ?1");
+    s.bind(1, claim.job_id).bind(2, run_seconds).bind(3, now_rfc3339());
+    s.step();
+  }
+  clear_results(db, claim.job_id);
+  insert_results(db, claim.job_id, files);
+  tx.commit();
+  return ClaimState::held;
 }
 
 std::vector<ResultFile> SqliteStore::results(const std::string& id) {

@@ -25,13 +25,18 @@ class SqliteStore final : public JobStore {
   void probe() override;
   SubmitResult submit(const NewJob& job, std::int64_t max_queue) override;
   std::optional<JobRecord> find(const std::string& id) override;
-  std::vector<JobRecord> list(const std::vector<JobStatus>& statuses, int limit) override;
+  std::vector<JobRecord> list(const std::vector<JobStatus>& statuses, const std::string& name,
+                              int limit) override;
+  std::vector<std::string> ids_with_prefix(const std::string& prefix, int limit) override;
   std::optional<JobRecord> claim_next(const Claimant& who) override;
   std::int64_t renew_leases(const Claimant& who) override;
   ClaimState update_progress(const Claim& claim, double percent) override;
   ClaimState finish(const Claim& claim, const JobEnd& end) override;
   ClaimState requeue(const Claim& claim) override;
+  std::optional<JobRecord> cancel(const std::string& id) override;
   std::optional<JobRecord> dismiss(const std::string& id) override;
+  ClaimState keep_results(const Claim& claim, const std::vector<ResultFile>& files,
+                          double run_seconds) override;
   std::vector<ResultFile> results(const std::string& id) override;
   RecoveryReport recover(int max_attempts) override;
   StatusCounts count_by_status() override;
