@@ -195,6 +195,11 @@ TEST_F(OgcTest, AnExecutionIsAJobOfTheJobsRoutes) {
   const Json jobs = get_json("/jobs");
   ASSERT_EQ(jobs["jobs"].size(), 1u);
   EXPECT_EQ(jobs["jobs"][0]["jobID"], id);
+  // OGC's job-list filters: every job is of process hmpm and type process.
+  EXPECT_EQ(get_json("/jobs?processID=hmpm&type=process")["jobs"].size(), 1u);
+  EXPECT_EQ(get_json("/jobs?processID=other,hmpm")["jobs"].size(), 1u);
+  EXPECT_EQ(get_json("/jobs?processID=other")["jobs"].size(), 0u);
+  EXPECT_EQ(get_json("/jobs?type=coverage")["jobs"].size(), 0u);
   res = client_->Delete(("/jobs/" + id).c_str());  // dismiss
   ASSERT_TRUE(res);
   EXPECT_EQ(json_of(res->body).value("status", ""), "dismissed");

@@ -676,7 +676,7 @@ TEST_F(RoutesTest, UnknownQueryParametersAre400NamingTheAcceptedOnes) {
   const std::string id = submit(small_spec("q"));
   Json p = expect_problem(client_->Get("/jobs?nmae=x"), 400, "invalid-parameter");
   EXPECT_EQ(p["errors"][0]["path"], "nmae");
-  EXPECT_EQ(p["accepted"], Json::array({"status", "name", "limit"}));
+  EXPECT_EQ(p["accepted"], Json::array({"status", "name", "limit", "processID", "type"}));
   EXPECT_NE(p.value("detail", "").find("status, name, limit"), std::string::npos);
   p = expect_problem(client_->Get(("/jobs/" + id + "?verbose=1").c_str()), 400,
                      "invalid-parameter");

@@ -1,10 +1,10 @@
 // jobs.cpp — POST/GET /jobs, POST /validate, GET/DELETE /jobs/{id},
 // POST /jobs/{id}/cancel, GET /jobs/{id}/spec and /log.
 #include <charconv>
-#include <utility>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <utility>
 
 #include "digest.hpp"
 #include "documents.hpp"
@@ -184,8 +184,15 @@ void list_jobs(Context& c, const httplib::Request& req, httplib::Response& res) 
   for (const auto& [param, only] : {std::pair<const char*, const char*>{"processID", "hmpm"},
                                     std::pair<const char*, const char*>{"type", "process"}}) {
     for (std::size_t i = 0; i < req.get_param_value_count(param); ++i) {
-      std::string values = "," + req.get_param_value(param, i) + ",";
-      if (values.find(std::string(",") + only + ",") == std::string::npos) none = true;
+      bool listed = false;
+      const std::string values = req.get_param_value(param, i);
+      std::size_t start = 0;
+      while (start <= values.size()) {
+        const std::size_t comma = std::min(values.find(',', start), values.size());
+        if (values.compare(start, comma - start, only) == 0) listed = true;
+        start = comma + 1;
+      }
+      if (!listed) none = true;
     }
   }
   Json jobs = Json::array();

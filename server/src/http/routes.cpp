@@ -25,7 +25,11 @@ std::vector<Route> route_table() {
       {Method::get, "/health", Access::open, get_health},
       {Method::get, "/metrics", Access::token, get_metrics},
       {Method::post, "/jobs", Access::token, post_job},
-      {Method::get, "/jobs", Access::token, list_jobs, {"status", "name", "limit", "processID", "type"}},
+      {Method::get,
+       "/jobs",
+       Access::token,
+       list_jobs,
+       {"status", "name", "limit", "processID", "type"}},
       {Method::post, "/validate", Access::token, validate_spec},
       {Method::get, job, Access::token, get_job},
       {Method::del, job, Access::token, dismiss_job},
@@ -37,7 +41,7 @@ std::vector<Route> route_table() {
       {Method::get, job + "/events", Access::token, stream_events},
       {Method::get, "/ui(/.*)?", Access::open, get_ui},
       // OGC API – Processes (ogc.cpp); its jobs are the /jobs routes above.
-      {Method::get, "/", Access::open, get_landing_page}  // links only; a browser goes on to /ui,
+      {Method::get, "/", Access::open, get_landing_page},  // links only; a browser goes on to /ui
       {Method::get, "/conformance", Access::token, get_conformance},
       {Method::get, "/processes", Access::token, list_processes},
       {Method::get, "/processes/([^/]+)", Access::token, get_process},
