@@ -128,6 +128,21 @@ TEST_F(OgcTest, ABrowserIsSentToTheDashboardAndEveryOtherClientGetsJson) {
   }
 }
 
+TEST_F(OgcTest, TheEncodingParameterFIsJsonOrHtmlForTheLandingPage) {
+  start();
+  for (const char* path :
+       {"/?f=json", "/conformance?f=json", "/processes?f=json", "/processes/hmpm?f=json"}) {
+    auto res = client_->Get(path);
+    ASSERT_TRUE(res) << path;
+    EXPECT_EQ(res->status, 200) << path;
+  }
+  auto html = client_->Get("/?f=html");
+  ASSERT_TRUE(html);
+  EXPECT_EQ(html->status, 303);
+  EXPECT_EQ(html->get_header_value("Location"), "/ui");
+  EXPECT_EQ(problem(client_->Get("/processes?f=xml"), 400).first, "invalid-parameter");
+}
+
 TEST_F(OgcTest, ConformanceNamesCoreJsonJobListAndDismiss) {
   start();
   const Json doc = get_json("/conformance");

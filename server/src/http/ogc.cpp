@@ -256,11 +256,23 @@ std::optional<std::string> spec_of(const std::string& body, int max_depth, httpl
   return dump(*spec);
 }
 
+// OGC's `f` parameter: `json` (the only encoding here) or absent; false
+// after a 400 naming it otherwise.
+bool json_requested(const httplib::Request& req, httplib::Response& res) {
+  if (!req.has_param("f") || req.get_param_value("f") == "json") return true;
+  send_invalid_parameter(res, "f must be json (the only encoding of this document)", "f",
+                         "unknown encoding '" + req.get_param_value("f") + "'");
+  return false;
+}
+
 }  // namespace
 
 void get_landing_page(Context&, const httplib::Request& req, httplib::Response& res) {
   res.set_header("Vary", "Accept");
-  if (prefers_html(req.get_header_value("Accept"))) return res.set_redirect("/ui", 303);
+  const bool html = req.has_param("f") ? req.get_param_value("f") == "html"
+                                       : prefers_html(req.get_header_value("Accept"));
+  if (html) return res.set_redirect("/ui", 303);
+  if (!json_requested(req, res)) return;
   send_json(
       res, 200,
       Json{{"title", "hmpm-server"},
@@ -276,7 +288,8 @@ void get_landing_page(Context&, const httplib::Request& req, httplib::Response& 
                          link("/jobs", rel_job_list, "application/json", "the jobs")})}});
 }
 
-void get_conformance(Context&, const httplib::Request&, httplib::Response& res) {
+void get_conformance(Context&, const httplib::Request& req, httplib::Response& res) {
+  if (!json_requested(req, res)) return;
   const std::string base = "http://www.opengis.net/spec/ogcapi-processes-1/1.0/conf/";
   Json classes = Json::array();
   for (const char* c : {"core", "json", "ogc-process-description", "job-list", "dismiss"})
@@ -284,7 +297,8 @@ void get_conformance(Context&, const httplib::Request&, httplib::Response& res) 
   send_json(res, 200, Json{{"conformsTo", classes}});
 }
 
-void list_processes(Context&, const httplib::Request&, httplib::Response& res) {
+void list_processes(Context&, const httplib::Request& req, httplib::Response& res) {
+  if (!json_requested(req, res)) return;
   send_json(res, 200,
             Json{{"processes", Json::array({process_summary()})},
                  {"links",
@@ -292,7 +306,7 @@ void list_processes(Context&, const httplib::Request&, httplib::Response& res) {
 }
 
 void get_process(Context&, const httplib::Request& req, httplib::Response& res) {
-  if (!known_process(req, res)) return;
+  if (!json_requested(req, res) || !known_process(req, res)) return;
   send_json(res, 200, process_description());
 }
 

@@ -41,10 +41,14 @@ std::vector<Route> route_table() {
       {Method::get, job + "/events", Access::token, stream_events},
       {Method::get, "/ui(/.*)?", Access::open, get_ui},
       // OGC API – Processes (ogc.cpp); its jobs are the /jobs routes above.
-      {Method::get, "/", Access::open, get_landing_page},  // links only; a browser goes on to /ui
-      {Method::get, "/conformance", Access::token, get_conformance},
-      {Method::get, "/processes", Access::token, list_processes},
-      {Method::get, "/processes/([^/]+)", Access::token, get_process},
+      {Method::get,
+       "/",
+       Access::open,
+       get_landing_page,
+       {"f"}},  // links only; a browser goes on to /ui
+      {Method::get, "/conformance", Access::token, get_conformance, {"f"}},
+      {Method::get, "/processes", Access::token, list_processes, {"f"}},
+      {Method::get, "/processes/([^/]+)", Access::token, get_process, {"f"}},
       {Method::post, "/processes/([^/]+)/execution", Access::token, execute_process},
   };
 }
