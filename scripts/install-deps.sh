@@ -15,6 +15,7 @@ packages=(
   libgtest-dev libgmock-dev            # tests
   libbenchmark-dev wrk                 # bench/ (wrk: bench/service.sh status reads)
   valgrind                             # docs/performance.md instruction counts
+  clang-format clang-tidy              # scripts/check_format.sh, scripts/check_tidy.sh (run by test.sh)
   python3                              # clients and result checks
   python3-meshio python3-matplotlib python3-jsonschema python3-numpy
   python3-owslib                       # tests/python/test_ogc.py: OGC API – Processes client

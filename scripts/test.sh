@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # One command from a fresh clone to a tested build: installs dependencies,
-# builds everything, runs every C++ test (ctest), every Python test and the
+# builds everything, checks the C++ formatting (clang-format) and lint
+# (clang-tidy), runs every C++ test (ctest), every Python test and the
 # dashboard's browser tests (headless Chromium with Debian's chromium-driver
 # and python3-selenium, which install-deps.sh installs; about 25 s).
 set -euo pipefail
@@ -9,6 +10,8 @@ bash scripts/install-deps.sh
 bash scripts/build.sh
 jobs=$(nproc 2>/dev/null || echo 2)
 status=0
+bash scripts/check_format.sh || status=1
+bash scripts/check_tidy.sh || status=1
 (cd build && ctest --output-on-failure -j "$jobs" --timeout 600) || status=1
 py=$(bash scripts/python.sh)
 if [ -d tests/python ] && ls tests/python/test_*.py >/dev/null 2>&1; then

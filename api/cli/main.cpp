@@ -28,10 +28,10 @@ namespace {
 
 using hmpm::api::exit_status;
 using hmpm::api::ExitCode;
-constexpr int kExitOk = exit_status(ExitCode::ok);
-constexpr int kExitUsage = exit_status(ExitCode::usage);
-constexpr int kExitInvalid = exit_status(ExitCode::invalid_spec);
-constexpr int kExitRunFailed = exit_status(ExitCode::run_failed);
+constexpr int exit_ok = exit_status(ExitCode::ok);
+constexpr int exit_usage = exit_status(ExitCode::usage);
+constexpr int exit_invalid = exit_status(ExitCode::invalid_spec);
+constexpr int exit_run_failed = exit_status(ExitCode::run_failed);
 
 std::atomic<bool> g_cancel{false};
 
@@ -39,7 +39,7 @@ extern "C" void on_interrupt(int) {
   g_cancel.store(true);
 }
 
-const char* const kUsage =
+const char* const usage_text =
     "usage:\n"
     "  hmpm run SPEC.json --out DIR [--threads N]   run a job locally, write results into DIR\n"
     "  hmpm validate SPEC.json                      check a job spec, print its cost estimate\n"
@@ -51,8 +51,8 @@ const char* const kUsage =
     "--threads N: solver threads (default: every core). Ctrl-C stops a run cleanly.\n";
 
 int usage_error(const std::string& what) {
-  std::cerr << "hmpm: " << what << "\n" << kUsage;
-  return kExitUsage;
+  std::cerr << "hmpm: " << what << "\n" << usage_text;
+  return exit_usage;
 }
 
 bool read_spec(const std::string& path, std::string& text) {
@@ -73,12 +73,12 @@ int load(const std::string& path, hmpm::api::ParseResult& result) {
   std::string text;
   if (!read_spec(path, text)) {
     std::cerr << "hmpm: cannot read " << path << "\n";
-    return kExitUsage;
+    return exit_usage;
   }
   result = hmpm::api::parse_job(text);
-  if (result.ok()) return kExitOk;
+  if (result.ok()) return exit_ok;
   for (const auto& e : result.errors) std::cerr << e.path << ": " << e.message << "\n";
-  return kExitInvalid;
+  return exit_invalid;
 }
 
 void print_cost(const hmpm::api::CostEstimate& c) {
@@ -104,12 +104,12 @@ std::string format_seconds(double s) {
 int command_validate(const std::vector<std::string>& args) {
   if (args.size() != 1) return usage_error("validate takes exactly one SPEC");
   hmpm::api::ParseResult result;
-  if (const int rc = load(args[0], result); rc != kExitOk) return rc;
+  if (const int rc = load(args[0], result); rc != exit_ok) return rc;
   std::cout << "valid: " << result.job->name << "\n";
   print_cost(result.job->cost);
   for (const auto& w : result.job->warnings)
     std::cerr << "hmpm: warning: " << w.path << ": " << w.message << "\n";
-  return kExitOk;
+  return exit_ok;
 }
 
 int command_run(const std::vector<std::string>& args) {
@@ -135,7 +135,7 @@ int command_run(const std::vector<std::string>& args) {
   }
   if (spec.empty() || out.empty()) return usage_error("run needs SPEC and --out DIR");
   hmpm::api::ParseResult result;
-  if (const int rc = load(spec, result); rc != kExitOk) return rc;
+  if (const int rc = load(spec, result); rc != exit_ok) return rc;
 
   hmpm::RunOptions options;
   options.threads = threads < 1 ? 1 : threads;
@@ -164,24 +164,24 @@ int command_run(const std::vector<std::string>& args) {
   } catch (const std::exception& e) {
     if (tty) std::fputs("\n", stderr);
     std::cerr << "hmpm: " << e.what() << "\n";
-    return kExitRunFailed;
+    return exit_run_failed;
   }
   if (tty) std::fputs("\n", stderr);
   const hmpm::RunResult& r = outcome.run;
   for (const auto& w : r.warnings) std::cerr << "hmpm: warning: " << w << "\n";
   if (r.status != hmpm::RunStatus::successful) {
     std::cerr << "hmpm: run " << hmpm::status_name(r.status) << ": " << r.message << "\n";
-    return kExitRunFailed;
+    return exit_run_failed;
   }
   std::cout << "successful: " << r.steps << " steps of " << r.dt << " s, " << r.particles
             << " particles, " << r.solve_seconds << " s (" << r.particle_steps_per_second
             << " particle-steps/s); results in " << out << "\n";
-  return kExitOk;
+  return exit_ok;
 }
 
 int command_spec_keys() {
   std::cout << hmpm::api::spec_tables_json();
-  return kExitOk;
+  return exit_ok;
 }
 
 }  // namespace
@@ -193,12 +193,12 @@ int main(int argc, char** argv) {
   args.erase(args.begin());
   if (command == "--help" || command == "-h" || command == "help") {
     std::cout << "hmpm " << hmpm::api::version() << " — hydro-mechanical MPM for saturated soils\n"
-              << kUsage;
-    return kExitOk;
+              << usage_text;
+    return exit_ok;
   }
   if (command == "--version") {
     std::cout << "hmpm " << hmpm::api::version() << "\n";
-    return kExitOk;
+    return exit_ok;
   }
   if (command == "validate") return command_validate(args);
   if (command == "run") return command_run(args);

@@ -22,7 +22,7 @@
 
 namespace hmpm::api {
 
-using json = nlohmann::json;
+using json = nlohmann::json;  // NOLINT(readability-identifier-naming): nlohmann's own spelling
 
 /// RFC 6901: "~" -> "~0", "/" -> "~1".
 std::string escape_pointer_token(std::string_view token);

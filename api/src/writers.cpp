@@ -71,8 +71,8 @@ std::string json_string(const std::string& s) {
   return out + "\"";
 }
 
-const char* const kVectorSuffix[] = {"x", "y", "z"};
-const char* const kTensorSuffix[] = {"xx", "yy", "zz", "xy", "yz", "zx"};
+const char* const vector_suffix[] = {"x", "y", "z"};
+const char* const tensor_suffix[] = {"xx", "yy", "zz", "xy", "yz", "zx"};
 
 // Value of `field` (index f) for series particle p, row r, component c.
 double series_value(const Series& s, std::size_t f, std::size_t r, std::size_t p, int nc, int c) {
@@ -198,9 +198,9 @@ void write_series_csv(const fs::path& path, const Series& s) {
         // Vectors always carry an axis suffix (also in 1D), scalars none.
         const FieldKind kind = field_info(s.fields[f]).kind;
         if (kind == FieldKind::tensor)
-          line += std::string("_") + kTensorSuffix[c];
+          line += std::string("_") + tensor_suffix[c];
         else if (kind == FieldKind::vector)
-          line += std::string("_") + kVectorSuffix[c];
+          line += std::string("_") + vector_suffix[c];
       }
     }
   }
@@ -225,7 +225,7 @@ void write_series_csv(const fs::path& path, const Series& s) {
 
 namespace {
 
-constexpr char kBase64[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+constexpr char base64_digits[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
 
 // Streams base64 of a byte sequence fed in pieces.
 class Base64Writer {
@@ -257,10 +257,10 @@ class Base64Writer {
  private:
   void flush_group() {
     const unsigned v = (unsigned{pending_[0]} << 16) | (unsigned{pending_[1]} << 8) | pending_[2];
-    buffer_ += kBase64[(v >> 18) & 63];
-    buffer_ += kBase64[(v >> 12) & 63];
-    buffer_ += kBase64[(v >> 6) & 63];
-    buffer_ += kBase64[v & 63];
+    buffer_ += base64_digits[(v >> 18) & 63];
+    buffer_ += base64_digits[(v >> 12) & 63];
+    buffer_ += base64_digits[(v >> 6) & 63];
+    buffer_ += base64_digits[v & 63];
     count_ = 0;
   }
   std::ostream& out_;

@@ -128,7 +128,7 @@ class Simulation {
   void for_particles(unsigned fields, Phase&& phase) {
     auto chunk = [&](int t, std::size_t b, std::size_t e) { phase(scatter_of(t), b, e); };
     if (!fields) {
-      pool_->for_blocks(particles_.size(), block_of(particles_.size(), kParticleBlock), chunk);
+      pool_->for_blocks(particles_.size(), block_of(particles_.size(), particle_block), chunk);
       return;
     }
     pool_->for_ranges(particles_.size(), chunk);
@@ -150,7 +150,7 @@ class Simulation {
     const auto offset = static_cast<std::size_t>(lo);
     auto band = [&](int t, std::size_t b, std::size_t e) { reduce(t, offset + b, offset + e); };
     const auto nodes = static_cast<std::size_t>(hi - lo + 1);
-    pool_->for_blocks(nodes, block_of(nodes, kNodeBlock), band);
+    pool_->for_blocks(nodes, block_of(nodes, node_block), band);
   }
 
   /// Runs f(begin, end) over blocks of the nodes [0, grid count), taken by
@@ -167,13 +167,13 @@ class Simulation {
       f(static_cast<std::int64_t>(b), static_cast<std::int64_t>(e));
     };
     const auto nodes = static_cast<std::size_t>(grid_.count);
-    pool_->for_blocks(nodes, block_of(nodes, kNodeBlock), chunk);
+    pool_->for_blocks(nodes, block_of(nodes, node_block), chunk);
   }
 
   /// Block sizes of dynamically shared loops: at most a few hundred
   /// microseconds of work, and at least 16 blocks per thread, so the faster
   /// thread can take up the slack (small runs get small blocks).
-  static constexpr std::size_t kParticleBlock = 4096, kNodeBlock = 8192;
+  static constexpr std::size_t particle_block = 4096, node_block = 8192;
   std::size_t block_of(std::size_t n, std::size_t largest) const {
     return std::clamp<std::size_t>(n / (16 * static_cast<std::size_t>(pool_->size())), 64, largest);
   }

@@ -22,7 +22,7 @@ namespace hmpm {
 
 template <int Dim, class Shape>
 RunResult Simulation<Dim, Shape>::run(const RunOptions& options) {
-  using clock = std::chrono::steady_clock;
+  using Clock = std::chrono::steady_clock;
   RunResult result;
   ExplicitScheme<Dim, Shape> scheme(*this);
   TimeScheme& time_scheme = scheme;  // the loop sees the interface only
@@ -84,7 +84,7 @@ RunResult Simulation<Dim, Shape>::run(const RunOptions& options) {
   double next_snapshot = out.snapshot_interval;
   const double eps_t = 1e-9 * dt;
 
-  const auto start = clock::now();
+  const auto start = Clock::now();
   auto last_progress = start;
   auto report = [&](std::int64_t n, double t) {
     if (!options.on_progress) return;
@@ -133,7 +133,7 @@ RunResult Simulation<Dim, Shape>::run(const RunOptions& options) {
       take_snapshot(t);
       while (next_snapshot <= t + eps_t) next_snapshot += out.snapshot_interval;
     }
-    const auto now = clock::now();
+    const auto now = Clock::now();
     if (std::chrono::duration<double>(now - last_progress).count() >= options.progress_interval_s) {
       last_progress = now;
       report(n + 1, t);
@@ -150,7 +150,7 @@ RunResult Simulation<Dim, Shape>::run(const RunOptions& options) {
       }
     }
   }
-  const double seconds = std::chrono::duration<double>(clock::now() - start).count();
+  const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
   result.steps = n;
   result.end_time = t;
   result.solve_seconds = seconds;

@@ -30,7 +30,7 @@ struct Mutation {
   const char* message_part = "";  ///< ... and its message must contain this
 };
 
-const Mutation kMutations[] = {
+const Mutation mutations[] = {
     {"missing_time", "/time", nullptr, "/time", "is required"},
     {"unknown_top_key", "/dimensoin", "2", "/dimensoin", "did you mean 'dimension'?"},
     {"dimension_4", "/dimension", "4", "/dimension", "[1, 3]"},
@@ -216,7 +216,7 @@ TEST(MalformedSpecs, EachCaseMutatesTheValidSpec) {
   EXPECT_TRUE(base.ok()) << listing(base);
   const json valid = json::parse(valid_text);
   std::set<std::string> names;
-  for (const Mutation& m : kMutations) {
+  for (const Mutation& m : mutations) {
     EXPECT_TRUE(names.insert(m.name).second) << "two cases are named " << m.name;
     EXPECT_NE(mutated(m), valid) << m.name << " does not change the valid spec";
   }
@@ -227,7 +227,7 @@ TEST(MalformedSpecs, EachCaseMutatesTheValidSpec) {
 }
 
 TEST(MalformedSpecs, ParseJobReportsTheExactPointer) {
-  for (const Mutation& m : kMutations) {
+  for (const Mutation& m : mutations) {
     SCOPED_TRACE(m.name);
     const ParseResult r = parse_job(mutated(m).dump());
     EXPECT_FALSE(r.ok());
@@ -307,7 +307,7 @@ TEST(MalformedSpecs, CommandLineExitsTwoWithPointerLines) {
     EXPECT_EQ(r.exit_code, 2) << r.err;
     EXPECT_NE(("\n" + r.err).find("\n" + path + ": "), std::string::npos) << r.err;
   };
-  for (const Mutation& m : kMutations) check(m.name, mutated(m).dump(), m.expected_path);
+  for (const Mutation& m : mutations) check(m.name, mutated(m).dump(), m.expected_path);
   for (const RawCase& c : raw_cases()) check(c.name, c.text, c.expected_path);
 }
 

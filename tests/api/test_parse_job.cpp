@@ -15,7 +15,7 @@
 namespace hmpm::api {
 namespace {
 
-using json = nlohmann::json;
+using json = nlohmann::json;  // NOLINT(readability-identifier-naming): nlohmann's own spelling
 using testing::read_text;
 using testing::source_path;
 

@@ -59,6 +59,7 @@ class ServerProcess {
         ::setenv("HMPM_TOKEN", env_token.c_str(), 1);
       }
       std::vector<char*> argv;
+      argv.reserve(args.size() + 1);
       for (auto& a : args) argv.push_back(a.data());
       argv.push_back(nullptr);
       ::execv(argv[0], argv.data());
@@ -168,6 +169,7 @@ int run_program(std::vector<std::string> args, double timeout_s) {
     const int null = ::open("/dev/null", O_WRONLY);
     ::dup2(null, STDOUT_FILENO);
     std::vector<char*> argv;
+    argv.reserve(args.size() + 1);
     for (auto& a : args) argv.push_back(a.data());
     argv.push_back(nullptr);
     ::execv(argv[0], argv.data());
@@ -410,6 +412,7 @@ TEST_F(ServiceTest, EightClientsSubmitNinetySixJobsWhilePolling) {
   std::vector<std::string> ids;
   std::vector<std::string> problems;
   std::vector<std::thread> threads;
+  threads.reserve(clients);
   for (int c = 0; c < clients; ++c) {
     threads.emplace_back([&, c] {
       auto client = server_->client();

@@ -323,6 +323,7 @@ TEST_P(StoreContract, ConcurrentWritersNeverFail) {
   constexpr int per_thread = 40;
   JobStore& s = store();
   std::vector<std::thread> pool;
+  pool.reserve(threads);
   std::atomic<int> failures{0};
   for (int t = 0; t < threads; ++t) {
     pool.emplace_back([&, t] {
@@ -330,7 +331,7 @@ TEST_P(StoreContract, ConcurrentWritersNeverFail) {
         try {
           NewJob j = job("concurrent");
           j.id = "10000000-0000-4000-8000-";
-          j.id += std::to_string(100000000000 + t * 1000 + i);
+          j.id += std::to_string(100000000000 + t * 1000L + i);
           s.submit(j, 100000);
           if (auto claimed = s.claim_next(live())) s.update_progress(claim_of(*claimed), 1);
           s.list({}, "", 5);

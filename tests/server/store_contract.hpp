@@ -28,6 +28,7 @@ struct StoreBackend {
 };
 
 /// Prints the backend's name in failure messages.
+// NOLINTNEXTLINE(readability-identifier-naming): GoogleTest looks the printer up by this name.
 inline void PrintTo(const StoreBackend& backend, std::ostream* os) {
   *os << backend.name;
 }

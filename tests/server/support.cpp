@@ -58,9 +58,9 @@ std::string long_spec(const std::string& name, double end_s) {
 std::filesystem::path make_temp_dir(const std::string& tag) {
   static std::atomic<int> counter{0};
   std::random_device random;
-  const auto dir = std::filesystem::temp_directory_path() /
-                   ("hmpm-" + tag + "-" + std::to_string(::getpid()) + "-" +
-                    std::to_string(counter++) + "-" + std::to_string(random() % 100000));
+  auto dir = std::filesystem::temp_directory_path() /
+             ("hmpm-" + tag + "-" + std::to_string(::getpid()) + "-" + std::to_string(counter++) +
+              "-" + std::to_string(random() % 100000));
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
   return dir;

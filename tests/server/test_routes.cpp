@@ -86,7 +86,7 @@ class RoutesTest : public ::testing::Test {
 
   // Submits a job that runs for hours and waits until a worker runs it.
   std::string submit_running(const std::string& name) {
-    const std::string id = submit(long_spec(name, 10000));
+    std::string id = submit(long_spec(name, 10000));
     EXPECT_EQ(wait_until(id, "running", 30).value("status", ""), "running");
     return id;
   }
@@ -101,7 +101,7 @@ class RoutesTest : public ::testing::Test {
     if (!res) return {};
     EXPECT_EQ(res->status, status) << res->body;
     EXPECT_EQ(res->get_header_value("Content-Type"), "application/problem+json");
-    const Json doc = json_of(res->body);
+    Json doc = json_of(res->body);
     EXPECT_TRUE(doc.is_object()) << res->body;
     if (!doc.is_object()) return {};
     EXPECT_EQ(doc.value("type", ""), type);
@@ -286,7 +286,7 @@ TEST_F(RoutesTest, AllowListsExactlyTheMethodsServed) {
 
 TEST_F(RoutesTest, BodiesWithoutLengthOrOverTheLimitAreRefused) {
   ServiceConfig c = config();
-  c.max_body_bytes = 64 * 1024;
+  c.max_body_bytes = std::size_t{64} * 1024;
   start(c);
   std::string res =
       raw_http(port_, "POST /jobs HTTP/1.1\r\nHost: x\r\nConnection: close\r\n\r\n{}");
@@ -300,7 +300,7 @@ TEST_F(RoutesTest, BodiesWithoutLengthOrOverTheLimitAreRefused) {
       port_, "POST /jobs HTTP/1.1\r\nHost: x\r\nContent-Length: abc\r\nConnection: close\r\n\r\n");
   EXPECT_EQ(raw_status(res), 400) << res;
 
-  const std::string big(200 * 1024, ' ');
+  const std::string big(std::size_t{200} * 1024, ' ');
   expect_problem(client_->Post("/jobs", big, "application/json"), 413, "payload-too-large");
   res = raw_http(port_,
                  "POST /jobs HTTP/1.1\r\nHost: x\r\nContent-Length: " + std::to_string(big.size()) +

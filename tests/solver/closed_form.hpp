@@ -71,8 +71,8 @@ struct Mandel {
   double nu, nu_u, a, c, p0;
   std::vector<double> roots;
 
-  Mandel(double nu_, double nu_u_, double a_, double c_, double p0_, int terms = 400)
-      : nu(nu_), nu_u(nu_u_), a(a_), c(c_), p0(p0_) {
+  Mandel(double nu_in, double nu_u_in, double a_in, double c_in, double p0_in, int terms = 400)
+      : nu(nu_in), nu_u(nu_u_in), a(a_in), c(c_in), p0(p0_in) {
     const double k = (1 - nu) / (nu_u - nu);
     // f = sin - k a cos changes sign once on each bracket; bisection to round-off.
     auto f = [k](double x) { return std::sin(x) - k * x * std::cos(x); };

@@ -53,27 +53,27 @@ struct MandelCase {
 
   double h() const { return a / cells; }
   double b() const { return rows * h(); }
-  double G() const { return E / (2 * (1 + nu)); }
+  double shear_modulus() const { return E / (2 * (1 + nu)); }
   double lambda() const { return E * nu / ((1 + nu) * (1 - 2 * nu)); }
-  double M() const { return kf / porosity; }  // incompressible grains: Biot modulus Kf/n
-  double oedometric() const { return lambda() + 2 * G(); }
-  double K() const { return lambda() + 2 * G() / 3; }
-  double B() const { return M() / (K() + M()); }
+  double biot_modulus() const { return kf / porosity; }  // incompressible grains: Biot modulus Kf/n
+  double oedometric() const { return lambda() + 2 * shear_modulus(); }
+  double bulk_modulus() const { return lambda() + 2 * shear_modulus() / 3; }
+  double skempton_b() const { return biot_modulus() / (bulk_modulus() + biot_modulus()); }
   double nu_u() const {
-    const double ku = K() + M();
-    return (3 * ku - 2 * G()) / (2 * (3 * ku + G()));
+    const double ku = bulk_modulus() + biot_modulus();
+    return (3 * ku - 2 * shear_modulus()) / (2 * (3 * ku + shear_modulus()));
   }
-  double c() const { return k / gamma_w / (1 / M() + 1 / oedometric()); }
-  double p0() const { return q * B() * (1 + nu_u()) / 3; }
+  double c() const { return k / gamma_w / (1 / biot_modulus() + 1 / oedometric()); }
+  double p0() const { return q * skempton_b() * (1 + nu_u()) / 3; }
   double time_of(double T) const { return T * a * a / c(); }
   double rho() const { return (1 - porosity) * rho_s + porosity * rho_f; }
-  double c_undrained() const { return std::sqrt((oedometric() + M()) / rho()); }
+  double c_undrained() const { return std::sqrt((oedometric() + biot_modulus()) / rho()); }
   /// Quasi-static measure: the lateral face moves by about
   /// a q (nu_u - nu) / (2G) over the consolidation, at the rate of a
   /// diffusion front, times the undrained impedance rho c1, over p0 — the
   /// relative size of the pressure waves inertia adds at T (cf. Terzaghi).
   double inertia_number(double T) const {
-    const double du = a * q * (nu_u() - nu) / (2 * G());
+    const double du = a * q * (nu_u() - nu) / (2 * shear_modulus());
     const double rate = du * std::sqrt(c() / (closed_form::pi * time_of(T))) / a;
     return rho() * c_undrained() * rate / p0();
   }
@@ -100,10 +100,10 @@ hmpm::Problem mandel(const MandelCase& c, double end) {
   body.particles_per_cell = c.ppc;
   // Undrained state at t = 0+: total stress sigma_xx = 0, sigma_yy = -q,
   // eps_zz = 0 with the undrained modulus lambda_u = lambda + M.
-  const double lu = c.lambda() + c.M(), G = c.G();
+  const double lu = c.lambda() + c.biot_modulus(), G = c.shear_modulus();
   const double e = -c.q / (2 * (lu + G));  // volumetric strain
   const double exx = 0.5 * (e + c.q / (2 * G)), eyy = 0.5 * (e - c.q / (2 * G));
-  const double p0 = -c.M() * e;
+  const double p0 = -c.biot_modulus() * e;
   const double sxx = c.lambda() * e + 2 * G * exx, syy = c.lambda() * e + 2 * G * eyy,
                szz = c.lambda() * e;
   body.initial.pore_pressure = [p0](const hmpm::Vec3&) { return p0; };
@@ -149,7 +149,8 @@ Result run_mandel(const MandelCase& c, double T_end, int samples) {
   const hmpm::Series& s = r.series;
   const std::size_t np = s.particles.size();
   Result out;
-  out.exact_p0 = -c.M() * (-c.q / (2 * (c.lambda() + c.M() + c.G())));
+  out.exact_p0 =
+      -c.biot_modulus() * (-c.q / (2 * (c.lambda() + c.biot_modulus() + c.shear_modulus())));
   const double x_centre = s.initial_positions[0][0];  // particle 0: nearest the centre
   for (std::size_t row = 0; row < s.time.size(); ++row) {
     const double t = s.time[row];

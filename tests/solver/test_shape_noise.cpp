@@ -29,7 +29,7 @@ struct NoiseCase {
   double rho = 1000, g = 9.81;
   double strain = 0.3;  // rho g H / E: compressive strain at the base
   double h() const { return H / cells; }
-  double E() const { return rho * g * H / strain; }
+  double youngs_modulus() const { return rho * g * H / strain; }
 };
 
 struct Noise {
@@ -52,7 +52,7 @@ Noise run_column(const NoiseCase& c, hmpm::ShapeFunction shape) {
   hmpm::Material m;
   m.name = "soft";
   m.density = c.rho;
-  m.youngs_modulus = c.E();
+  m.youngs_modulus = c.youngs_modulus();
   m.poisson_ratio = 0.0;
   p.materials.push_back(m);
   hmpm::Body b;
@@ -76,7 +76,7 @@ Noise run_column(const NoiseCase& c, hmpm::ShapeFunction shape) {
   floor.velocity[1] = problems::constant(0.0);
   p.boundaries.push_back(floor);
   // 25 periods of the first mode of the undeformed column, 4H/c.
-  p.time.end = 25 * 4 * c.H / std::sqrt(c.E() / c.rho);
+  p.time.end = 25 * 4 * c.H / std::sqrt(c.youngs_modulus() / c.rho);
   p.output.snapshot_interval = p.time.end;
   p.output.snapshot_fields = {hmpm::Field::position, hmpm::Field::effective_stress,
                               hmpm::Field::displacement};

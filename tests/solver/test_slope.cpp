@@ -69,8 +69,8 @@ struct SlopeCase {
     return rho() * g * std::cos(beta()) * H;
   }  // total normal stress at the base
   double kappa() const { return nu / (1 - nu); }
-  double E_oed() const { return E * (1 - nu) / ((1 + nu) * (1 - 2 * nu)); }
-  double c_v() const { return k / (rho_f * g * (1 / E_oed() + n / Kf)); }
+  double e_oed() const { return E * (1 - nu) / ((1 + nu) * (1 - 2 * nu)); }
+  double c_v() const { return k / (rho_f * g * (1 / e_oed() + n / Kf)); }
   double mu() const { return std::sin(phi_deg * pi / 180); }  // Davis, psi = 0
   double r0() const { return rho_f / rho(); }
   double r_fail() const { return 1 - std::tan(beta()) / mu(); }
@@ -82,7 +82,7 @@ struct SlopeCase {
     if (t < t0 || t > t_peak() + rise / s) return 0.0;
     return t < t_peak() ? s : -s;
   }
-  double FS(double t) const { return (1 - r(t)) * mu() / std::tan(beta()); }
+  double factor_of_safety(double t) const { return (1 - r(t)) * mu() / std::tan(beta()); }
   /// Quasi-steady pore pressure at depth d (steady profile plus ramp lag).
   double pressure(double d, double t) const {
     const double R = r_rate(t) * scale();
@@ -208,13 +208,13 @@ SlopeRun run_slope(const SlopeCase& c, double end) {
       // time constant 0.08 s: 5 time constants).
       const bool settled = t < c.t0 || t > c.t0 + 5 * c.H * c.H / (pi * pi * c.c_v());
       const double err = std::abs(s.values[1][row * np + i] - c.pressure(d, t)) / c.scale();
-      if (settled && c.FS(t) >= 1.05 && t < c.t_peak())
+      if (settled && c.factor_of_safety(t) >= 1.05 && t < c.t_peak())
         out.max_p_error = std::max(out.max_p_error, err);
       if (t > end - 0.3) out.max_p_error_after = std::max(out.max_p_error_after, err);
     }
     out.time.push_back(t);
     out.mean_u.push_back(u);
-    if (c.FS(t) >= 1.05 && t < c.t_peak())
+    if (c.factor_of_safety(t) >= 1.05 && t < c.t_peak())
       out.max_u_at_rest = std::max(out.max_u_at_rest, std::abs(u));
   }
   return out;

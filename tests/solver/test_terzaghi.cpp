@@ -23,11 +23,11 @@ struct TerzaghiCase {
   // problem quasi-static, as Terzaghi's solution assumes (see InertiaNumber).
   double porosity = 0.3, rho_s = 2650, E = 10e6, nu = 0.0, kw = 75e6, q = 1e3, k = 1e-5;
   double m_v() const { return (1 + nu) * (1 - 2 * nu) / (E * (1 - nu)); }
-  double Q() const { return porosity / kw; }
-  double cv() const { return k / (1000.0 * 9.81 * (m_v() + Q())); }
+  double storage() const { return porosity / kw; }
+  double cv() const { return k / (1000.0 * 9.81 * (m_v() + storage())); }
   double time_of(double tv) const { return tv * H * H / cv(); }
   double rho() const { return (1 - porosity) * rho_s + porosity * 1000.0; }
-  double c_undrained() const { return std::sqrt((1 / m_v() + 1 / Q()) / rho()); }
+  double c_undrained() const { return std::sqrt((1 / m_v() + 1 / storage()) / rho()); }
   /// Terzaghi's settlement rate q m_v sqrt(c_v/(pi t)) times the impedance
   /// rho c1, over q: the size of the pressure waves the dynamic equations add
   /// to the quasi-static solution at T_v.

@@ -5,14 +5,14 @@
 namespace hmpm::api::parse {
 namespace {
 
-constexpr std::string_view kBody[] = {"material", "box", "particles_per_cell", "initial"};
-constexpr std::string_view kBodyRequired[] = {"material", "box"};
-constexpr std::string_view kInitial[] = {"velocity", "pore_pressure", "effective_stress"};
-constexpr int kMaxParticlesPerCell = 10;
+constexpr std::string_view body_allowed[] = {"material", "box", "particles_per_cell", "initial"};
+constexpr std::string_view body_required[] = {"material", "box"};
+constexpr std::string_view initial_allowed[] = {"velocity", "pore_pressure", "effective_stress"};
+constexpr int max_particles_per_cell = 10;
 
 void read_initial(ParseContext& c, Body& body, const json& j, const std::string& path) {
   SpecReader& r = c.r;
-  if (!r.object(j, path, kInitial)) return;
+  if (!r.object(j, path, initial_allowed)) return;
   if (j.contains("velocity")) {
     const json& v = j["velocity"];
     const std::string vp = path + "/velocity";
@@ -49,7 +49,7 @@ void read_body(ParseContext& c, const json& j, const std::string& path) {
   SpecReader& r = c.r;
   Body body;
   body.material = -1;
-  if (!r.object(j, path, kBody, kBodyRequired)) return;
+  if (!r.object(j, path, body_allowed, body_required)) return;
   if (j.contains("material")) {
     if (auto name = r.string(j["material"], path + "/material", 100)) {
       if (auto it = c.material_index.find(*name); it != c.material_index.end()) {
@@ -66,7 +66,7 @@ void read_body(ParseContext& c, const json& j, const std::string& path) {
     if (auto b = read_box(c, j["box"], path + "/box")) body.box = *b;
   if (j.contains("particles_per_cell"))
     if (auto n = r.integer(j["particles_per_cell"], path + "/particles_per_cell", 1,
-                           kMaxParticlesPerCell))
+                           max_particles_per_cell))
       body.particles_per_cell = static_cast<int>(*n);
   if (j.contains("initial")) read_initial(c, body, j["initial"], path + "/initial");
   c.p.bodies.push_back(std::move(body));
@@ -75,9 +75,9 @@ void read_body(ParseContext& c, const json& j, const std::string& path) {
 }  // namespace
 
 void body_keys(std::vector<SpecObjectKeys>& out) {
-  out.push_back(keys_entry("/bodies/*", kBody));
+  out.push_back(keys_entry("/bodies/*", body_allowed));
   out.push_back(keys_entry("/bodies/*/box", box_key_names()));
-  out.push_back(keys_entry("/bodies/*/initial", kInitial));
+  out.push_back(keys_entry("/bodies/*/initial", initial_allowed));
 }
 
 void read_bodies(ParseContext& c, const json& j, const std::string& path) {

@@ -7,13 +7,13 @@
 namespace hmpm::api::parse {
 namespace {
 
-constexpr std::string_view kBoundary[] = {"nodes", "velocity", "pore_pressure", "rigid",
-                                          "friction"};
-constexpr std::string_view kBoundaryRequired[] = {"nodes"};
+constexpr std::string_view boundary_allowed[] = {"nodes", "velocity", "pore_pressure", "rigid",
+                                                 "friction"};
+constexpr std::string_view boundary_required[] = {"nodes"};
 
 void read_boundary(ParseContext& c, const json& j, const std::string& path) {
   SpecReader& r = c.r;
-  if (!r.object(j, path, kBoundary, kBoundaryRequired)) return;
+  if (!r.object(j, path, boundary_allowed, boundary_required)) return;
   Boundary b;
   if (j.contains("nodes")) {
     bool all = false;
@@ -88,7 +88,7 @@ void read_boundary(ParseContext& c, const json& j, const std::string& path) {
 }  // namespace
 
 void boundary_keys(std::vector<SpecObjectKeys>& out) {
-  out.push_back(keys_entry("/boundaries/*", kBoundary));
+  out.push_back(keys_entry("/boundaries/*", boundary_allowed));
   out.push_back(keys_entry("/boundaries/*/nodes", selection_key_names()));
   out.push_back(keys_entry("/boundaries/*/nodes/box", box_key_names()));
 }

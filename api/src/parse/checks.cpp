@@ -12,9 +12,9 @@ namespace hmpm::api::parse {
 namespace {
 
 // Work bound for laying out bodies (bodies x cells summed over the axes).
-constexpr double kMaxLayoutWork = 5e7;
+constexpr double max_layout_work = 5e7;
 // Work bound for checks that visit every particle per selection.
-constexpr double kMaxNearWork = 2e8;
+constexpr double max_near_work = 2e8;
 
 bool check_particle_budget(ParseContext& c) {
   // Count particles from the layout rule without generating them, so a huge
@@ -25,11 +25,11 @@ bool check_particle_budget(ParseContext& c) {
   double axis_cells = 0;
   for (int a = 0; a < c.dim; ++a) axis_cells += p.grid.cells[a];
   const double layout_work = axis_cells * static_cast<double>(p.bodies.size());
-  if (layout_work > kMaxLayoutWork) {
+  if (layout_work > max_layout_work) {
     c.r.error("/bodies", std::to_string(p.bodies.size()) + " bodies on a grid of " +
                              format_count(axis_cells) +
                              " cells summed over the axes is too much work to lay out (" +
-                             format_count(layout_work) + " > " + format_count(kMaxLayoutWork) +
+                             format_count(layout_work) + " > " + format_count(max_layout_work) +
                              "); merge bodies");
     return false;
   }
@@ -44,7 +44,7 @@ bool check_particle_budget(ParseContext& c) {
       if (along > static_cast<double>(c.limits.max_particles)) {
         c.r.error(child_pointer("/bodies", b) + "/particles_per_cell",
                   "body would have " + format_count(along) + " particles along " +
-                      std::string(kAxisNames[a]) + "; the limit is " +
+                      std::string(axis_names[a]) + "; the limit is " +
                       std::to_string(c.limits.max_particles) + " particles in all");
         return false;
       }
@@ -63,7 +63,7 @@ bool check_particle_budget(ParseContext& c) {
 void resolve_near(ParseContext& c) {
   if (c.near.empty()) return;
   const std::int64_t n = count_particles(c.p);
-  if (static_cast<double>(c.near.size()) * static_cast<double>(n) > kMaxNearWork) {
+  if (static_cast<double>(c.near.size()) * static_cast<double>(n) > max_near_work) {
     c.r.error("/output/series/particles",
               std::to_string(c.near.size()) + " 'near' selections over " + std::to_string(n) +
                   " particles is too much work to resolve; name particles by index instead");
@@ -83,7 +83,7 @@ void check_traction_selections(ParseContext& c) {
   const Problem& p = c.p;
   if (p.tractions.empty() ||
       static_cast<double>(p.tractions.size()) * static_cast<double>(count_particles(p)) >
-          kMaxNearWork)
+          max_near_work)
     return;
   const std::vector<Vec3> positions = initial_positions(p);
   for (std::size_t k = 0; k < p.tractions.size(); ++k) {

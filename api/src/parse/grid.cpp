@@ -7,18 +7,18 @@
 namespace hmpm::api::parse {
 namespace {
 
-constexpr std::string_view kGrid[] = {"min", "max", "cells"};
-constexpr std::string_view kShapes[] = {"linear", "gimp", "bspline"};
+constexpr std::string_view grid_allowed[] = {"min", "max", "cells"};
+constexpr std::string_view shape_names[] = {"linear", "gimp", "bspline"};
 
 }  // namespace
 
 void grid_keys(std::vector<SpecObjectKeys>& out) {
-  out.push_back(keys_entry("/grid", kGrid));
+  out.push_back(keys_entry("/grid", grid_allowed));
 }
 
 void read_grid(ParseContext& c, const json& j, const std::string& path) {
   SpecReader& r = c.r;
-  if (!r.object(j, path, kGrid, kGrid)) return;
+  if (!r.object(j, path, grid_allowed, grid_allowed)) return;
   const std::size_t before = r.error_count();
   std::optional<Vec3> lo, hi;
   if (j.contains("min")) lo = r.vector(j["min"], path + "/min", c.dim);
@@ -52,11 +52,11 @@ void read_grid(ParseContext& c, const json& j, const std::string& path) {
 }
 
 Keys shape_function_names() {
-  return kShapes;
+  return shape_names;
 }
 
 void read_shape_function(ParseContext& c, const json& j, const std::string& path) {
-  if (auto s = c.r.one_of(j, path, kShapes))
+  if (auto s = c.r.one_of(j, path, shape_names))
     c.p.shape_function = *s == "gimp"      ? ShapeFunction::gimp
                          : *s == "bspline" ? ShapeFunction::bspline
                                            : ShapeFunction::linear;

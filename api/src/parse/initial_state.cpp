@@ -5,23 +5,23 @@
 namespace hmpm::api::parse {
 namespace {
 
-constexpr std::string_view kInitialState[] = {"geostatic"};
-constexpr std::string_view kGeostatic[] = {"water_table", "k0"};
+constexpr std::string_view initial_state_allowed[] = {"geostatic"};
+constexpr std::string_view geostatic_allowed[] = {"water_table", "k0"};
 
 }  // namespace
 
 void initial_state_keys(std::vector<SpecObjectKeys>& out) {
-  out.push_back(keys_entry("/initial_state", kInitialState));
-  out.push_back(keys_entry("/initial_state/geostatic", kGeostatic));
+  out.push_back(keys_entry("/initial_state", initial_state_allowed));
+  out.push_back(keys_entry("/initial_state/geostatic", geostatic_allowed));
 }
 
 void read_initial_state(ParseContext& c, const json& j, const std::string& path) {
   SpecReader& r = c.r;
-  if (!r.object(j, path, kInitialState)) return;
+  if (!r.object(j, path, initial_state_allowed)) return;
   if (!j.contains("geostatic")) return;
   const json& g = j["geostatic"];
   const std::string gp = path + "/geostatic";
-  if (!r.object(g, gp, kGeostatic)) return;
+  if (!r.object(g, gp, geostatic_allowed)) return;
   Geostatic geo;
   r.number_at(g, gp, "water_table", Range::any(), geo.water_table);
   if (g.contains("k0")) {

@@ -13,17 +13,17 @@ namespace hmpm::api {
 namespace parse {
 namespace {
 
-constexpr std::string_view kTop[] = {
+constexpr std::string_view top_allowed[] = {
     "name",          "description",      "dimension",    "grid",      "shape_function", "materials",
     "bodies",        "gravity",          "boundaries",   "tractions", "time",           "output",
     "local_damping", "gravity_constant", "initial_state"};
-constexpr std::string_view kTopRequired[] = {"dimension", "grid", "materials", "bodies", "time"};
+constexpr std::string_view top_required[] = {"dimension", "grid", "materials", "bodies", "time"};
 // At most this many errors are reported (then one line counting the rest).
-constexpr std::size_t kMaxErrors = 1000;
+constexpr std::size_t max_errors = 1000;
 
 void read_root(ParseContext& c, const json& root) {
   SpecReader& r = c.r;
-  if (!r.object(root, "", kTop, kTopRequired)) return;
+  if (!r.object(root, "", top_allowed, top_required)) return;
   if (root.contains("name"))
     if (auto s = r.string(root["name"], "/name", 200)) c.name = *s;
   if (root.contains("description")) r.string(root["description"], "/description", 100'000);
@@ -70,9 +70,9 @@ ParseResult parse_text(std::string_view text, const Limits& limits) {
   if (c.r.error_count() == 0) check_whole_problem(c);
   result.errors = std::move(c.r.errors());
   // A hostile spec can hold millions of mistakes; the first thousand say enough.
-  if (result.errors.size() > kMaxErrors) {
-    const std::size_t more = result.errors.size() - kMaxErrors;
-    result.errors.resize(kMaxErrors);
+  if (result.errors.size() > max_errors) {
+    const std::size_t more = result.errors.size() - max_errors;
+    result.errors.resize(max_errors);
     result.errors.push_back({"", std::to_string(more) + " more errors not shown"});
   }
   if (result.errors.empty()) {
@@ -97,7 +97,7 @@ SpecObjectKeys keys_entry(std::string location, Keys keys) {
 
 const std::vector<SpecObjectKeys>& spec_object_keys() {
   static const std::vector<SpecObjectKeys> table = [] {
-    std::vector<SpecObjectKeys> t{parse::keys_entry("", parse::kTop)};
+    std::vector<SpecObjectKeys> t{parse::keys_entry("", parse::top_allowed)};
     parse::grid_keys(t);
     parse::material_keys(t);
     parse::body_keys(t);

@@ -30,10 +30,10 @@ std::string append_parts(std::string pointer, std::string_view relative) {
 }  // namespace
 
 std::string pointer_of_solver_location(const Problem& p, const std::string& where) {
-  constexpr std::string_view kMaterials = "materials/";
+  constexpr std::string_view materials_prefix = "materials/";
   const std::string_view w = where;
-  if (w.starts_with(kMaterials)) {
-    const std::string_view rest = w.substr(kMaterials.size());
+  if (w.starts_with(materials_prefix)) {
+    const std::string_view rest = w.substr(materials_prefix.size());
     for (const Material& m : p.materials) {
       if (!rest.starts_with(m.name) || rest.size() <= m.name.size() + 1 ||
           rest[m.name.size()] != '/')

@@ -10,20 +10,21 @@ namespace hmpm::api::parse {
 namespace {
 
 // Keys every material reads; the model's parameters and "hydraulic" follow.
-constexpr std::string_view kMaterialCommon[] = {"model", "density", "youngs_modulus",
-                                                "poisson_ratio"};
-constexpr std::string_view kMaterialRequired[] = {"model", "density", "youngs_modulus",
+constexpr std::string_view material_common_allowed[] = {"model", "density", "youngs_modulus",
+                                                        "poisson_ratio"};
+constexpr std::string_view material_required[] = {"model", "density", "youngs_modulus",
                                                   "poisson_ratio"};
-constexpr std::string_view kHydraulic[] = {"porosity",           "hydraulic_conductivity",
-                                           "fluid_bulk_modulus", "fluid_density",
-                                           "solid_bulk_modulus", "darcy_inertia"};
-constexpr std::string_view kHydraulicRequired[] = {"porosity", "hydraulic_conductivity",
+constexpr std::string_view hydraulic_allowed[] = {"porosity",           "hydraulic_conductivity",
+                                                  "fluid_bulk_modulus", "fluid_density",
+                                                  "solid_bulk_modulus", "darcy_inertia"};
+constexpr std::string_view hydraulic_required[] = {"porosity", "hydraulic_conductivity",
                                                    "fluid_bulk_modulus"};
 
 // The keys a material accepts: the common ones, every model's parameters, "hydraulic".
 Keys material_key_names() {
   static const std::vector<std::string_view> keys = [] {
-    std::vector<std::string_view> out(std::begin(kMaterialCommon), std::end(kMaterialCommon));
+    std::vector<std::string_view> out(std::begin(material_common_allowed),
+                                      std::end(material_common_allowed));
     for (std::string_view k : model_parameter_keys()) out.push_back(k);
     out.push_back("hydraulic");
     return out;
@@ -63,7 +64,7 @@ Plasticity read_model(SpecReader& r, const MaterialModel& model, const json& j,
 }
 
 void read_hydraulic(SpecReader& r, Material& m, const json& j, const std::string& path) {
-  if (!r.object(j, path, kHydraulic, kHydraulicRequired)) return;
+  if (!r.object(j, path, hydraulic_allowed, hydraulic_required)) return;
   Hydraulic h;
   r.number_at(j, path, "porosity", {0.0, 1.0, true, true}, h.porosity);
   if (j.contains("hydraulic_conductivity"))
@@ -85,7 +86,7 @@ void read_material(ParseContext& c, const std::string& name, const json& j,
   m.name = name;
   if (name.empty() || name.size() > 100)
     r.error(path, "material names must have 1 to 100 characters");
-  if (r.object(j, path, material_key_names(), kMaterialRequired)) {
+  if (r.object(j, path, material_key_names(), material_required)) {
     r.number_at(j, path, "density", Range::positive(), m.density);
     r.number_at(j, path, "youngs_modulus", Range::positive(), m.youngs_modulus);
     if (j.contains("poisson_ratio")) {
@@ -113,7 +114,7 @@ void read_material(ParseContext& c, const std::string& name, const json& j,
 
 void material_keys(std::vector<SpecObjectKeys>& out) {
   out.push_back(keys_entry("/materials/*", material_key_names()));
-  out.push_back(keys_entry("/materials/*/hydraulic", kHydraulic));
+  out.push_back(keys_entry("/materials/*/hydraulic", hydraulic_allowed));
 }
 
 bool is_material_key_path(std::string_view relative) {
@@ -122,8 +123,9 @@ bool is_material_key_path(std::string_view relative) {
   const Keys keys = material_key_names();
   if (std::find(keys.begin(), keys.end(), head) == keys.end()) return false;
   if (slash == std::string_view::npos) return true;
-  return head == "hydraulic" && std::find(std::begin(kHydraulic), std::end(kHydraulic),
-                                          relative.substr(slash + 1)) != std::end(kHydraulic);
+  return head == "hydraulic" &&
+         std::find(std::begin(hydraulic_allowed), std::end(hydraulic_allowed),
+                   relative.substr(slash + 1)) != std::end(hydraulic_allowed);
 }
 
 void read_materials(ParseContext& c, const json& j, const std::string& path) {

@@ -8,12 +8,12 @@
 namespace hmpm::api::parse {
 namespace {
 
-constexpr std::string_view kOutput[] = {"series", "snapshots"};
-constexpr std::string_view kSeries[] = {"particles", "fields", "interval"};
-constexpr std::string_view kSeriesRequired[] = {"particles", "fields"};
-constexpr std::string_view kNear[] = {"near"};
-constexpr std::string_view kSnapshots[] = {"interval", "fields"};
-constexpr std::string_view kSnapshotsRequired[] = {"interval"};
+constexpr std::string_view output_allowed[] = {"series", "snapshots"};
+constexpr std::string_view series_allowed[] = {"particles", "fields", "interval"};
+constexpr std::string_view series_required[] = {"particles", "fields"};
+constexpr std::string_view near_allowed[] = {"near"};
+constexpr std::string_view snapshots_allowed[] = {"interval", "fields"};
+constexpr std::string_view snapshots_required[] = {"interval"};
 
 std::vector<Field> read_fields(SpecReader& r, const json& j, const std::string& path) {
   std::vector<Field> out;
@@ -48,7 +48,7 @@ void read_series_particles(ParseContext& c, const json& parts, const std::string
     const json& e = parts[i];
     out.series_particles.push_back(-1);
     if (e.is_object()) {
-      if (r.object(e, ip, kNear, kNear) && e.contains("near"))
+      if (r.object(e, ip, near_allowed, near_allowed) && e.contains("near"))
         if (auto at = r.vector(e["near"], ip + "/near", c.dim))
           c.near.push_back({out.series_particles.size() - 1, *at, ip});
     } else if (e.is_number()) {
@@ -67,6 +67,7 @@ void read_series_particles(ParseContext& c, const json& parts, const std::string
 Keys field_names() {
   static const std::vector<std::string_view> names = [] {
     std::vector<std::string_view> out;
+    out.reserve(field_table.size());
     for (const FieldInfo& f : field_table) out.push_back(f.name);
     return out;
   }();
@@ -74,20 +75,20 @@ Keys field_names() {
 }
 
 void output_keys(std::vector<SpecObjectKeys>& out) {
-  out.push_back(keys_entry("/output", kOutput));
-  out.push_back(keys_entry("/output/series", kSeries));
-  out.push_back(keys_entry("/output/series/particles/*", kNear));
-  out.push_back(keys_entry("/output/snapshots", kSnapshots));
+  out.push_back(keys_entry("/output", output_allowed));
+  out.push_back(keys_entry("/output/series", series_allowed));
+  out.push_back(keys_entry("/output/series/particles/*", near_allowed));
+  out.push_back(keys_entry("/output/snapshots", snapshots_allowed));
 }
 
 void read_output(ParseContext& c, const json& j, const std::string& path) {
   SpecReader& r = c.r;
-  if (!r.object(j, path, kOutput)) return;
+  if (!r.object(j, path, output_allowed)) return;
   OutputRequest& out = c.p.output;
   if (j.contains("series")) {
     const json& s = j["series"];
     const std::string sp = path + "/series";
-    if (r.object(s, sp, kSeries, kSeriesRequired)) {
+    if (r.object(s, sp, series_allowed, series_required)) {
       if (s.contains("particles")) read_series_particles(c, s["particles"], sp + "/particles");
       if (s.contains("fields")) out.series_fields = read_fields(r, s["fields"], sp + "/fields");
       r.number_at(s, sp, "interval", Range::non_negative(), out.series_interval);
@@ -96,7 +97,7 @@ void read_output(ParseContext& c, const json& j, const std::string& path) {
   if (j.contains("snapshots")) {
     const json& s = j["snapshots"];
     const std::string sp = path + "/snapshots";
-    if (r.object(s, sp, kSnapshots, kSnapshotsRequired)) {
+    if (r.object(s, sp, snapshots_allowed, snapshots_required)) {
       r.number_at(s, sp, "interval", Range::positive(), out.snapshot_interval);
       if (s.contains("fields")) {
         out.snapshot_fields = read_fields(r, s["fields"], sp + "/fields");

@@ -26,7 +26,7 @@ namespace hmpm::api::parse {
 
 using Keys = std::span<const std::string_view>;
 
-inline constexpr std::string_view kAxisNames[] = {"x", "y", "z"};
+inline constexpr std::string_view axis_names[] = {"x", "y", "z"};
 
 /// A formula (not a plain number) of position read from the spec, checked
 /// for finite values once the particles are known.

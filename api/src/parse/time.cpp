@@ -6,17 +6,17 @@
 namespace hmpm::api::parse {
 namespace {
 
-constexpr std::string_view kTime[] = {"end", "dt", "courant"};
-constexpr std::string_view kTimeRequired[] = {"end"};
+constexpr std::string_view time_allowed[] = {"end", "dt", "courant"};
+constexpr std::string_view time_required[] = {"end"};
 
 }  // namespace
 
 void time_keys(std::vector<SpecObjectKeys>& out) {
-  out.push_back(keys_entry("/time", kTime));
+  out.push_back(keys_entry("/time", time_allowed));
 }
 
 void read_time(ParseContext& c, const json& j, const std::string& path) {
-  if (!c.r.object(j, path, kTime, kTimeRequired)) return;
+  if (!c.r.object(j, path, time_allowed, time_required)) return;
   c.r.number_at(j, path, "end", Range::positive(), c.p.time.end);
   c.r.number_at(j, path, "dt", Range::positive(), c.p.time.dt);
   c.r.number_at(j, path, "courant", {0.0, 1.0, true, false}, c.p.time.courant);

@@ -5,24 +5,24 @@
 namespace hmpm::api::parse {
 namespace {
 
-constexpr std::string_view kTraction[] = {"particles", "face", "traction"};
-constexpr std::string_view kFaces[] = {"x-", "x+", "y-", "y+", "z-", "z+"};
+constexpr std::string_view traction_allowed[] = {"particles", "face", "traction"};
+constexpr std::string_view face_names[] = {"x-", "x+", "y-", "y+", "z-", "z+"};
 
 void read_traction(ParseContext& c, const json& j, const std::string& path) {
   SpecReader& r = c.r;
-  if (!r.object(j, path, kTraction, kTraction)) return;
+  if (!r.object(j, path, traction_allowed, traction_allowed)) return;
   Traction t;
   if (j.contains("particles")) {
     bool all = false;
     if (auto box = read_selection(c, j["particles"], path + "/particles", all)) t.particles = *box;
   }
   if (j.contains("face")) {
-    if (auto f = r.one_of(j["face"], path + "/face", kFaces)) {
+    if (auto f = r.one_of(j["face"], path + "/face", face_names)) {
       t.axis = (*f)[0] - 'x';
       t.side = (*f)[1] == '+' ? +1 : -1;
       if (c.dim > 0 && t.axis >= c.dim)
         r.error(path + "/face", "is '" + *f + "', but a " + std::to_string(c.dim) +
-                                    "D problem has no " + std::string(kAxisNames[t.axis]) +
+                                    "D problem has no " + std::string(axis_names[t.axis]) +
                                     " axis");
     }
   }
@@ -42,13 +42,13 @@ void read_traction(ParseContext& c, const json& j, const std::string& path) {
 }  // namespace
 
 void traction_keys(std::vector<SpecObjectKeys>& out) {
-  out.push_back(keys_entry("/tractions/*", kTraction));
+  out.push_back(keys_entry("/tractions/*", traction_allowed));
   out.push_back(keys_entry("/tractions/*/particles", selection_key_names()));
   out.push_back(keys_entry("/tractions/*/particles/box", box_key_names()));
 }
 
 std::span<const std::string_view> traction_faces() {
-  return kFaces;
+  return face_names;
 }
 
 void read_tractions(ParseContext& c, const json& j, const std::string& path) {

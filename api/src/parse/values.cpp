@@ -6,22 +6,22 @@
 namespace hmpm::api::parse {
 namespace {
 
-constexpr std::string_view kBox[] = {"min", "max"};
-constexpr std::string_view kSelection[] = {"box"};
+constexpr std::string_view box_allowed[] = {"min", "max"};
+constexpr std::string_view selection_allowed[] = {"box"};
 
 }  // namespace
 
 Keys box_key_names() {
-  return kBox;
+  return box_allowed;
 }
 
 Keys selection_key_names() {
-  return kSelection;
+  return selection_allowed;
 }
 
 std::optional<Box> read_box(ParseContext& c, const json& j, const std::string& path) {
   SpecReader& r = c.r;
-  if (!r.object(j, path, kBox, kBox)) return std::nullopt;
+  if (!r.object(j, path, box_allowed, box_allowed)) return std::nullopt;
   std::optional<Vec3> lo, hi;
   if (j.contains("min")) lo = r.vector(j["min"], path + "/min", c.dim);
   if (j.contains("max")) hi = r.vector(j["max"], path + "/max", c.dim);
@@ -38,7 +38,7 @@ std::optional<Box> read_box(ParseContext& c, const json& j, const std::string& p
     if (!c.grid_ok) continue;
     const double tol = 1e-9 * (grid.max[a] - grid.min[a]);
     const std::string range = "; the grid spans [" + format_number(grid.min[a]) + ", " +
-                              format_number(grid.max[a]) + "] along " + std::string(kAxisNames[a]);
+                              format_number(grid.max[a]) + "] along " + std::string(axis_names[a]);
     if ((*lo)[a] < grid.min[a] - tol || (*lo)[a] > grid.max[a] + tol) {
       r.error(child_pointer(path + "/min", a),
               "is " + format_number((*lo)[a]) + ", outside the grid" + range);
@@ -73,7 +73,8 @@ std::optional<Box> read_selection(ParseContext& c, const json& j, const std::str
                   j.type_name());
     return std::nullopt;
   }
-  if (!c.r.object(j, path, kSelection, kSelection) || !j.contains("box")) return std::nullopt;
+  if (!c.r.object(j, path, selection_allowed, selection_allowed) || !j.contains("box"))
+    return std::nullopt;
   return read_box(c, j["box"], path + "/box");
 }
 

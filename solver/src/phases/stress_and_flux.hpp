@@ -59,12 +59,12 @@ inline void Simulation<Dim, Shape>::update_particle_stress_and_fluid_flux(const 
     // Constants copied first: the stores to sig could alias mc for the compiler.
     const double lambda_tr = mc.lambda * tr, two_g = 2.0 * mc.shear_modulus;
     // Below 3D the shear increments yz and zx (in 1D also xy) are zero:
-    // the loops end before them (components 0..kEnd-1 can change).
-    constexpr int kEnd = Dim == 1 ? 3 : (Dim == 2 ? 4 : 6);
+    // the loops end before them (components 0..changed_end-1 can change).
+    constexpr int changed_end = Dim == 1 ? 3 : (Dim == 2 ? 4 : 6);
     for (int c = 0; c < 3; ++c) sig[c] += lambda_tr + two_g * de[c];
-    for (int c = 3; c < kEnd; ++c) sig[c] += two_g * de[c];
+    for (int c = 3; c < changed_end; ++c) sig[c] += two_g * de[c];
     if constexpr (Plastic) return_to_yield_surface(sig, mc, {particles_.internal.data(), p});
-    for (int c = 0; c < kEnd; ++c) particles_.strain[p][c] += de[c];
+    for (int c = 0; c < changed_end; ++c) particles_.strain[p][c] += de[c];
     // F = I + dt grad v, a plain matrix (its determinant inlines), filled
     // element by element: Eigen's assignment loop may be left out of line in
     // a translation unit whose inlining budget is spent, which changes the
