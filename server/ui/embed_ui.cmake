@@ -67,12 +67,12 @@ namespace hmpm::server::ui {
 namespace {
 ${arrays}}  // namespace
 
-const Asset kAssets[] = {
+const Asset assets[] = {
 ${table}};
-const std::size_t kAssetCount = sizeof kAssets / sizeof kAssets[0];
+const std::size_t asset_count = sizeof assets / sizeof assets[0];
 
 const Asset* find_asset(std::string_view path) {
-  for (const Asset& a : kAssets)
+  for (const Asset& a : assets)
     if (a.path == path) return &a;
   return nullptr;
 }

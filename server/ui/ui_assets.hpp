@@ -20,8 +20,8 @@ struct Asset {
 // Every embedded file; `/ui/examples/index.json` (a JSON array
 // of the example names) is generated with them. `/ui` itself is not listed:
 // the server answers it with "/ui/index.html".
-extern const Asset kAssets[];
-extern const std::size_t kAssetCount;
+extern const Asset assets[];
+extern const std::size_t asset_count;
 
 // The asset served at `path`, or nullptr (answer 404).
 const Asset* find_asset(std::string_view path);

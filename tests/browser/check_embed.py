@@ -26,8 +26,8 @@ DUMP = r"""
 // Writes each asset to argv[1]/<index>, and "path<TAB>type<TAB>index" lines to stdout.
 int main(int, char** argv) {
   using hmpm::server::ui::find_asset;
-  for (std::size_t i = 0; i < hmpm::server::ui::kAssetCount; ++i) {
-    const auto& a = hmpm::server::ui::kAssets[i];
+  for (std::size_t i = 0; i < hmpm::server::ui::asset_count; ++i) {
+    const auto& a = hmpm::server::ui::assets[i];
     if (find_asset(a.path) != &a) return 2;
     const std::string name = std::string(argv[1]) + "/" + std::to_string(i);
     std::FILE* f = std::fopen(name.c_str(), "wb");
