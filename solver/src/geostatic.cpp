@@ -98,24 +98,24 @@ std::vector<ProblemIssue> check_geostatic(const Problem& problem) {
   std::vector<ProblemIssue> issues;
   if (!problem.initial_state.geostatic) return issues;
   const Geostatic& geo = *problem.initial_state.geostatic;
-  const std::string where = "initial_state/geostatic";
+  const Location where{"initial_state", "geostatic"};
   const Vertical v = vertical_of(problem);
   if (v.axis < 0) {
-    issues.push_back({"gravity",
+    issues.push_back({{"gravity"},
                       "must have exactly one non-zero component for "
                       "initial_state.geostatic: the ground is layered across gravity"});
     return issues;
   }
   for (std::size_t b = 0; b < problem.bodies.size(); ++b) {
     const InitialFields& init = problem.bodies[b].initial;
-    const std::string w = "bodies/" + std::to_string(b) + "/initial/";
+    const Location w = Location{"bodies"} / b / "initial";
     if (init.pore_pressure)
-      issues.push_back({w + "pore_pressure",
+      issues.push_back({w / "pore_pressure",
                         "conflicts with initial_state.geostatic, which sets "
                         "the initial pore pressure of every body"});
     if (std::any_of(init.effective_stress.begin(), init.effective_stress.end(),
                     [](const FieldOfPosition& f) { return static_cast<bool>(f); }))
-      issues.push_back({w + "effective_stress",
+      issues.push_back({w / "effective_stress",
                         "conflicts with initial_state.geostatic, which "
                         "sets the initial effective stress of every body"});
   }
@@ -123,7 +123,7 @@ std::vector<ProblemIssue> check_geostatic(const Problem& problem) {
   for (const Material& m : problem.materials) {
     if (!m.hydraulic) continue;
     if (fluid && fluid->hydraulic->fluid_density != m.hydraulic->fluid_density)
-      issues.push_back({"materials/" + m.name + "/hydraulic/fluid_density",
+      issues.push_back({Location{"materials", m.name, "hydraulic", "fluid_density"},
                         "differs from that of material '" + fluid->name +
                             "': a geostatic state needs one pore fluid (one hydrostatic "
                             "pressure)"});
@@ -146,7 +146,7 @@ std::vector<ProblemIssue> check_geostatic(const Problem& problem) {
     const double tol = 1e-9 * (problem.grid.max[v.axis] - problem.grid.min[v.axis]);
     if (top > table + tol)
       issues.push_back(
-          {where + "/water_table",
+          {where / "water_table",
            "is " + fmt(*geo.water_table) + " but " + body +
                " (a material with 'hydraulic') reaches " + axis_name[v.axis] + " = " +
                fmt(v.up * top) +
@@ -166,7 +166,7 @@ std::vector<ProblemIssue> check_geostatic(const Problem& problem) {
           const Vec3 at{x, y, z};
           const double surface = surface_at(extents, at, v, dim);
           if (table > surface + tol) {
-            issues.push_back({where + "/water_table",
+            issues.push_back({where / "water_table",
                               "is " + fmt(*geo.water_table) + ", above the ground surface " +
                                   axis_name[v.axis] + " = " + fmt(v.up * surface) + " over " +
                                   body +

@@ -140,62 +140,64 @@ std::vector<ProblemIssue> problem_warnings(const Problem& problem) {
                   "oscillations can grow and the run can diverge. What to change: a stiffer "
                   "fluid_bulk_modulus, local_damping for quasi-static runs, or darcy_inertia: "
                   "false (drops the term)";
-    warnings.push_back({"materials/" + m.name + "/hydraulic", what});
+    warnings.push_back({Location{"materials", m.name, "hydraulic"}, what});
   }
   return warnings;
 }
 
 std::vector<ProblemIssue> check_problem(const Problem& problem) {
   std::vector<ProblemIssue> issues;
-  auto add = [&](std::string where, std::string msg) {
+  auto add = [&](Location where, std::string msg) {
     issues.push_back({std::move(where), std::move(msg)});
   };
   const int dim = problem.dimension;
   if (dim < 1 || dim > 3) {
-    add("dimension", "must be 1, 2 or 3");
+    add({"dimension"}, "must be 1, 2 or 3");
     return issues;
   }
   for (int a = 0; a < dim; ++a) {
-    if (problem.grid.cells[a] < 1) add("grid/cells/" + std::to_string(a), "must be >= 1");
+    if (problem.grid.cells[a] < 1)
+      add(Location{"grid", "cells"} / static_cast<std::size_t>(a), "must be >= 1");
     if (!(problem.grid.max[a] > problem.grid.min[a]))
-      add("grid/max/" + std::to_string(a), "must be greater than grid.min");
+      add(Location{"grid", "max"} / static_cast<std::size_t>(a), "must be greater than grid.min");
   }
   if (!issues.empty()) return issues;
 
   for (std::size_t i = 0; i < problem.materials.size(); ++i) {
     const Material& m = problem.materials[i];
-    const std::string w = "materials/" + m.name + "/";
-    if (!(m.density > 0)) add(w + "density", "must be > 0");
-    if (!(m.youngs_modulus > 0)) add(w + "youngs_modulus", "must be > 0");
+    const Location w{"materials", m.name};
+    if (!(m.density > 0)) add(w / "density", "must be > 0");
+    if (!(m.youngs_modulus > 0)) add(w / "youngs_modulus", "must be > 0");
     if (!(m.poisson_ratio > -1.0 && m.poisson_ratio < 0.5))
-      add(w + "poisson_ratio", "must be in (-1, 0.5)");
+      add(w / "poisson_ratio", "must be in (-1, 0.5)");
     if (m.hydraulic) {
       const Hydraulic& hy = *m.hydraulic;
-      if (!(hy.porosity > 0 && hy.porosity < 1)) add(w + "hydraulic/porosity", "must be in (0, 1)");
+      if (!(hy.porosity > 0 && hy.porosity < 1))
+        add(w / "hydraulic" / "porosity", "must be in (0, 1)");
       if (!(hy.hydraulic_conductivity >= 0))
-        add(w + "hydraulic/hydraulic_conductivity", "must be >= 0");
-      if (!(hy.fluid_bulk_modulus > 0)) add(w + "hydraulic/fluid_bulk_modulus", "must be > 0");
-      if (!(hy.fluid_density > 0)) add(w + "hydraulic/fluid_density", "must be > 0");
-      if (!(hy.solid_bulk_modulus > 0)) add(w + "hydraulic/solid_bulk_modulus", "must be > 0");
+        add(w / "hydraulic" / "hydraulic_conductivity", "must be >= 0");
+      if (!(hy.fluid_bulk_modulus > 0)) add(w / "hydraulic" / "fluid_bulk_modulus", "must be > 0");
+      if (!(hy.fluid_density > 0)) add(w / "hydraulic" / "fluid_density", "must be > 0");
+      if (!(hy.solid_bulk_modulus > 0)) add(w / "hydraulic" / "solid_bulk_modulus", "must be > 0");
     }
   }
-  if (problem.bodies.empty()) add("bodies", "at least one body is needed");
+  if (problem.bodies.empty()) add({"bodies"}, "at least one body is needed");
   for (std::size_t b = 0; b < problem.bodies.size(); ++b) {
     const Body& body = problem.bodies[b];
-    const std::string w = "bodies/" + std::to_string(b) + "/";
+    const Location w = Location{"bodies"} / b;
     if (body.material < 0 || body.material >= static_cast<int>(problem.materials.size()))
-      add(w + "material", "names no material");
+      add(w / "material", "names no material");
     if (body.particles_per_cell < 1)
-      add(w + "particles_per_cell", "must be >= 1");
+      add(w / "particles_per_cell", "must be >= 1");
     else if (body_layout(problem, body).count == 0)
-      add(w + "box",
+      add(w / "box",
           "contains no whole grid cell, so no particles; a body fills the cells "
           "that lie entirely inside its box");
   }
   for (std::size_t i = 0; i < problem.boundaries.size(); ++i) {
     const Boundary& bc = problem.boundaries[i];
     if (!bc.friction) continue;
-    const std::string w = "boundaries/" + std::to_string(i) + "/friction";
+    const Location w = Location{"boundaries"} / i / "friction";
     int prescribed = 0;
     for (int a = 0; a < dim; ++a) prescribed += bc.velocity[a] ? 1 : 0;
     if (dim == 1)
@@ -207,10 +209,10 @@ std::vector<ProblemIssue> check_problem(const Problem& problem) {
               std::to_string(prescribed));
     if (!(*bc.friction >= 0)) add(w, "must be >= 0");
   }
-  if (!(problem.time.end > 0)) add("time/end", "must be > 0");
+  if (!(problem.time.end > 0)) add({"time", "end"}, "must be > 0");
   if (!(problem.time.courant > 0 && problem.time.courant <= 1))
-    add("time/courant", "must be in (0, 1]");
-  if (problem.time.dt && !(*problem.time.dt > 0)) add("time/dt", "must be > 0");
+    add({"time", "courant"}, "must be in (0, 1]");
+  if (problem.time.dt && !(*problem.time.dt > 0)) add({"time", "dt"}, "must be > 0");
   if (!issues.empty()) return issues;
 
   const SchemeRules& scheme = scheme_rules(problem);
@@ -219,7 +221,7 @@ std::vector<ProblemIssue> check_problem(const Problem& problem) {
   for (std::size_t i = 0; i < problem.output.series_particles.size(); ++i) {
     const std::int64_t p = problem.output.series_particles[i];
     if (p < 0 || p >= n)
-      add("output/series/particles/" + std::to_string(i),
+      add(Location{"output", "series", "particles"} / i,
           "particle " + std::to_string(p) + " does not exist; there are " + std::to_string(n) +
               " particles (0.." + std::to_string(n - 1) + ")");
   }

@@ -15,7 +15,9 @@ RunResult run(const Problem& problem, const RunOptions& options) {
   const std::vector<ProblemIssue> issues = check_problem(problem);
   if (!issues.empty()) {
     std::string msg = "invalid problem:";
-    for (const ProblemIssue& i : issues) msg += " " + i.where + ": " + i.message + ";";
+    for (const ProblemIssue& i : issues) {
+      msg.append(" ").append(i.where.text()).append(": ").append(i.message).append(";");
+    }
     throw std::invalid_argument(msg);
   }
   switch (problem.dimension) {

@@ -60,7 +60,7 @@ void Simulation<Dim, Shape>::setup_materials() {
         std::max(state_variables_,
                  state_variable_count(constants_[static_cast<std::size_t>(body.material)].model));
   for (const ProblemIssue& w : problem_warnings(problem_))
-    warnings_.push_back(w.where + ": " + w.message);
+    warnings_.push_back(w.where.text().append(": ").append(w.message));
   for (int a = 0; a < Dim; ++a) gravity_[a] = problem_.gravity[a];
 }
 

@@ -197,7 +197,7 @@ void check_whole_problem(ParseContext& c) {
   if (!check_particle_budget(c)) return;
   resolve_near(c);
   for (const ProblemIssue& issue : check_problem(c.p))
-    c.r.error(pointer_of_solver_location(c.p, issue.where), issue.message);
+    c.r.error(pointer_of_solver_location(issue.where), issue.message);
   if (c.r.error_count() > 0) return;
   check_traction_selections(c);
   check_time_formulas(c);

@@ -80,7 +80,7 @@ ParseResult parse_text(std::string_view text, const Limits& limits) {
     job.name = c.name;
     job.cost = estimate_cost(c.p);
     for (const ProblemIssue& w : problem_warnings(c.p))
-      job.warnings.push_back({pointer_of_solver_location(c.p, w.where), w.message});
+      job.warnings.push_back({pointer_of_solver_location(w.where), w.message});
     job.problem = std::move(c.p);
     result.job = std::move(job);
   }

@@ -117,17 +117,6 @@ void material_keys(std::vector<SpecObjectKeys>& out) {
   out.push_back(keys_entry("/materials/*/hydraulic", hydraulic_allowed));
 }
 
-bool is_material_key_path(std::string_view relative) {
-  const std::size_t slash = relative.find('/');
-  const std::string_view head = relative.substr(0, slash);
-  const Keys keys = material_key_names();
-  if (std::find(keys.begin(), keys.end(), head) == keys.end()) return false;
-  if (slash == std::string_view::npos) return true;
-  return head == "hydraulic" &&
-         std::find(std::begin(hydraulic_allowed), std::end(hydraulic_allowed),
-                   relative.substr(slash + 1)) != std::end(hydraulic_allowed);
-}
-
 void read_materials(ParseContext& c, const json& j, const std::string& path) {
   if (!j.is_object()) {
     c.r.error(path, std::string("expected an object of named materials, got ") + j.type_name());

@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "hmpm/api/job.hpp"
+#include "hmpm/run.hpp"
 #include "spec_reader.hpp"
 
 namespace hmpm::api::parse {
@@ -102,13 +103,9 @@ std::optional<FieldOfTime> read_value_of_time(ParseContext& c, const json& j,
 /// traction selections, finite formulas and the limits (checks.cpp).
 void check_whole_problem(ParseContext& c);
 
-/// The JSON pointer of a location the solver reports in the job-spec
-/// vocabulary ("time/dt", "materials/NAME/hydraulic"), see locations.cpp.
-std::string pointer_of_solver_location(const Problem& p, const std::string& where);
-
-/// Is `relative` ("hydraulic/fluid_density", "density") a key path that
-/// the materials section accepts inside one material (materials.cpp)?
-bool is_material_key_path(std::string_view relative);
+/// The JSON pointer of a location the solver reports (its parts, each
+/// escaped: {"materials", "a/b"} -> "/materials/a~1b"), see locations.cpp.
+std::string pointer_of_solver_location(const Location& where);
 
 // ------------------------------------------------------------- key tables
 /// Appends the accepted keys of the section's objects (for spec_object_keys).

@@ -13,6 +13,7 @@
 #include <atomic>
 #include <cstdint>
 #include <functional>
+#include <initializer_list>
 #include <string>
 #include <vector>
 
@@ -23,8 +24,31 @@ namespace hmpm {
 /// A problem found in a Problem before running. `where` names the part in
 /// the vocabulary of the job spec (e.g. "time/dt", "bodies/0/box"), so the
 /// api can turn it into a JSON pointer.
+/// A place in the job spec as its parts (object keys and array indices), e.g.
+/// {"materials", "a/b", "hydraulic"}: the api turns the parts into a JSON
+/// pointer (escaping each), so a name holding '/' keeps its meaning.
+struct Location {
+  std::vector<std::string> parts;
+
+  Location() = default;
+  Location(std::initializer_list<std::string> p) : parts(p) {}
+  /// This location with one more part (a key, or an index).
+  Location operator/(std::string part) const {
+    Location l = *this;
+    l.parts.push_back(std::move(part));
+    return l;
+  }
+  Location operator/(std::size_t index) const { return *this / std::to_string(index); }
+  /// The parts joined by '/', for messages ("materials/a/b/hydraulic").
+  std::string text() const {
+    std::string out;
+    for (const std::string& part : parts) out += (out.empty() ? "" : "/") + part;
+    return out;
+  }
+};
+
 struct ProblemIssue {
-  std::string where;
+  Location where;
   std::string message;
 };
 

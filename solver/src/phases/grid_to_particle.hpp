@@ -41,8 +41,10 @@ __attribute__((always_inline)) inline void Simulation<Dim, Shape>::move_particle
   dx *= dt;
   Vec& x = particles_.x[p];
   x += dx;
-  bool inside = true;
-  for (int a = 0; a < Dim; ++a) inside &= (x[a] >= grid_.origin[a]) & (x[a] <= grid_max_[a]);
+  // Branch-free: one test per axis, which a NaN position also fails.
+  int inside = 1;
+  for (int a = 0; a < Dim; ++a)
+    inside &= static_cast<int>(x[a] >= grid_.origin[a]) & static_cast<int>(x[a] <= grid_max_[a]);
   if (!inside) [[unlikely]] {
     if (!x.allFinite() || !particles_.v[p].allFinite())
       fail_nonfinite(p, "velocity");

@@ -71,10 +71,10 @@ void check_explicit_step(const Problem& problem, const StableStep& s,
                         ? "the explicit hydraulic diffusion limit h^2/(2 d k/(gamma_w Q))"
                         : "the mechanical limit h/(c sqrt(d)) with undrained wave speed c = " +
                               fmt(s.wave_speed) + " m/s";
-  issues.push_back({"time/dt", "is " + fmt(*problem.time.dt) + " s, above the stable limit " +
-                                   fmt(s.limit) + " s (" + why + "); use dt <= " + fmt(s.limit) +
-                                   " or omit dt to let the solver choose " + fmt(0.5 * s.limit) +
-                                   " s"});
+  issues.push_back({{"time", "dt"},
+                    "is " + fmt(*problem.time.dt) + " s, above the stable limit " + fmt(s.limit) +
+                        " s (" + why + "); use dt <= " + fmt(s.limit) +
+                        " or omit dt to let the solver choose " + fmt(0.5 * s.limit) + " s"});
 }
 
 }  // namespace
