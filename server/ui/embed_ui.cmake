@@ -79,10 +79,5 @@ const Asset* find_asset(std::string_view path) {
 
 }  // namespace hmpm::server::ui
 ")
-set(old "")
-if(EXISTS "${OUT}")
-  file(READ "${OUT}" old)
-endif()
-if(NOT old STREQUAL text)
-  file(WRITE "${OUT}" "${text}")
-endif()
+include(${CMAKE_CURRENT_LIST_DIR}/../cmake/write_if_changed.cmake)
+write_if_changed("${OUT}" "${text}")
