@@ -1,5 +1,6 @@
 // jobs.cpp — POST/GET /jobs, POST /validate, GET/DELETE /jobs/{id},
 // POST /jobs/{id}/cancel, GET /jobs/{id}/spec and /log.
+#include <algorithm>
 #include <charconv>
 #include <filesystem>
 #include <fstream>
@@ -151,22 +152,35 @@ void submit_job(Context& c, const httplib::Request& req, httplib::Response& res,
   }
 }
 
-void list_jobs(Context& c, const httplib::Request& req, httplib::Response& res) {
-  std::vector<JobStatus> statuses;
-  for (std::size_t i = 0; i < req.get_param_value_count("status"); ++i) {
-    std::string values = req.get_param_value("status", i);
+namespace {
+
+// Every value of a query parameter given as comma-separated lists, possibly
+// repeated: ?status=a,b&status=c -> a, b, c.
+std::vector<std::string> param_values(const httplib::Request& req, const char* param) {
+  std::vector<std::string> out;
+  for (std::size_t i = 0; i < req.get_param_value_count(param); ++i) {
+    const std::string values = req.get_param_value(param, i);
     std::size_t start = 0;
     while (start <= values.size()) {
       const std::size_t comma = std::min(values.find(',', start), values.size());
-      const std::string value = values.substr(start, comma - start);
-      const auto status = parse_status(value);
-      if (!status) {
-        return send_invalid_parameter(res, "status must be " + status_names_text(), "status",
-                                      "unknown status '" + value + "'");
-      }
-      statuses.push_back(*status);
+      out.push_back(values.substr(start, comma - start));
       start = comma + 1;
     }
+  }
+  return out;
+}
+
+}  // namespace
+
+void list_jobs(Context& c, const httplib::Request& req, httplib::Response& res) {
+  std::vector<JobStatus> statuses;
+  for (const std::string& value : param_values(req, "status")) {
+    const auto status = parse_status(value);
+    if (!status) {
+      return send_invalid_parameter(res, "status must be " + status_names_text(), "status",
+                                    "unknown status '" + value + "'");
+    }
+    statuses.push_back(*status);
   }
   const std::string name = req.get_param_value("name");
   int limit = 100;
@@ -183,17 +197,9 @@ void list_jobs(Context& c, const httplib::Request& req, httplib::Response& res) 
   bool none = false;
   for (const auto& [param, only] : {std::pair<const char*, const char*>{"processID", "hmpm"},
                                     std::pair<const char*, const char*>{"type", "process"}}) {
-    for (std::size_t i = 0; i < req.get_param_value_count(param); ++i) {
-      bool listed = false;
-      const std::string values = req.get_param_value(param, i);
-      std::size_t start = 0;
-      while (start <= values.size()) {
-        const std::size_t comma = std::min(values.find(',', start), values.size());
-        if (values.compare(start, comma - start, only) == 0) listed = true;
-        start = comma + 1;
-      }
-      if (!listed) none = true;
-    }
+    if (!req.has_param(param)) continue;
+    const std::vector<std::string> values = param_values(req, param);
+    if (std::find(values.begin(), values.end(), only) == values.end()) none = true;
   }
   Json jobs = Json::array();
   if (!none) {
