@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <memory>
 #include <sstream>
 #include <string>
 #include <thread>
@@ -20,17 +21,33 @@
 
 namespace hmpm {
 
+/// The scheme problem.time.scheme names, over this simulation.
+template <int Dim, class Shape>
+std::unique_ptr<TimeScheme> make_scheme(Simulation<Dim, Shape>& sim, const Problem& problem) {
+  switch (problem.time.scheme) {
+    case Scheme::semi_implicit:  // added by the semi-implicit scheme
+    case Scheme::quasi_static:   // added by the quasi-static scheme
+    case Scheme::explicit_scheme:
+      break;
+  }
+  return std::make_unique<ExplicitScheme<Dim, Shape>>(sim);
+}
+
 template <int Dim, class Shape>
 RunResult Simulation<Dim, Shape>::run(const RunOptions& options) {
   using Clock = std::chrono::steady_clock;
   RunResult result;
-  ExplicitScheme<Dim, Shape> scheme(*this);
-  TimeScheme& time_scheme = scheme;  // the loop sees the interface only
+  const std::unique_ptr<TimeScheme> scheme = make_scheme(*this, problem_);
+  TimeScheme& time_scheme = *scheme;  // the loop sees the interface only
   stable_ = time_scheme.stable_step(problem_);
+  result.scheme = scheme_name(problem_.time.scheme);
+  // Fixed steps: step n ends at (n + 1) dt, the last at `end` exactly.
+  // Varying steps (quasi_static growth): the scheme says each length and
+  // `total` is its estimate, for progress only.
+  const bool fixed = stable_.fixed;
   const double dt = stable_.chosen;
   const double end = problem_.time.end;
-  const auto total =
-      std::max<std::int64_t>(1, static_cast<std::int64_t>(std::ceil(end / dt - 1e-9)));
+  std::int64_t total = std::max<std::int64_t>(1, stable_.steps);
   double min_mass = std::numeric_limits<double>::infinity();
   for (double m : particles_.mass) min_mass = std::min(min_mass, m);
   mass_tolerance_ = particles_.size() ? 1e-12 * min_mass : 0.0;
@@ -100,13 +117,22 @@ RunResult Simulation<Dim, Shape>::run(const RunOptions& options) {
   result.status = RunStatus::successful;
   std::int64_t n = 0;
   double t = 0.0;
-  for (; n < total; ++n) {
+  for (; fixed ? n < total : t < end; ++n) {
     if (options.cancel && options.cancel->load(std::memory_order_relaxed)) {
       result.status = RunStatus::cancelled;
       result.message = "cancelled at step " + std::to_string(n) + " (t = " + number(t) + " s)";
       break;
     }
-    const double t_new = (n + 1 == total) ? end : static_cast<double>(n + 1) * dt;
+    double t_new;
+    if (fixed) {
+      t_new = (n + 1 == total) ? end : static_cast<double>(n + 1) * dt;
+    } else {
+      // A step that would leave less than a hundredth of itself before
+      // `end` is stretched to end there.
+      const double h = time_scheme.next_dt(t);
+      t_new = t + h >= end - 0.01 * h ? end : t + h;
+      if (n + 1 >= total) total = n + 2;
+    }
     time_scheme.step(t, t_new - t);
     if (failed_) {
       std::ostringstream where;
@@ -151,6 +177,7 @@ RunResult Simulation<Dim, Shape>::run(const RunOptions& options) {
     }
   }
   const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  time_scheme.report(result);
   result.steps = n;
   result.end_time = t;
   result.solve_seconds = seconds;

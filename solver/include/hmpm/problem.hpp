@@ -181,11 +181,67 @@ struct InitialState {
   std::optional<Geostatic> geostatic;
 };
 
-struct TimeControl {
-  double end = 1.0;          ///< s, required
-  std::optional<double> dt;  ///< s; absent: automatic
-  double courant = 0.5;      ///< factor on the stable step when dt is automatic
+/// The time integration scheme of a run (docs/schemes.md says which to use).
+enum class Scheme {
+  /// Forward Euler u-p, momentum-based MUSL (the seed paper). dt is bounded
+  /// by the undrained wave speed and by the hydraulic diffusion limit.
+  explicit_scheme,
+  /// Momentum explicit, pore pressure implicit (a nodal pressure equation
+  /// solved each step): dt is bounded by the skeleton's wave speed only.
+  semi_implicit,
+  /// No inertia; implicit u-p, backward Euler, Newton iterations: any dt is
+  /// stable (consolidation over days to years).
+  quasi_static,
 };
+
+/// Geometric growth of the quasi-static step: dt_0 = initial, dt_{n+1} =
+/// min(max, growth * dt_n).
+struct StepGrowth {
+  double initial = 0.0;  ///< s, > 0
+  double max = 0.0;      ///< s, >= initial
+  double growth = 1.0;   ///< factor >= 1
+};
+
+/// Linear solver of the implicit schemes' sparse systems.
+enum class LinearSolver {
+  automatic,  ///< the scheme chooses by size (documented in docs/schemes.md)
+  direct,     ///< sparse Cholesky / LU (Eigen)
+  iterative,  ///< preconditioned conjugate gradients / BiCGSTAB (Eigen)
+};
+
+/// Convergence controls of the implicit schemes (ignored by the explicit one).
+struct ImplicitControl {
+  /// Newton converges when the residual norm falls below tolerance times
+  /// its norm at the start of the step (and the correction likewise).
+  double tolerance = 1e-8;
+  int max_iterations = 25;  ///< Newton iterations per step before a cut-back
+  int max_cutbacks = 8;     ///< halvings of a step before the run fails
+  LinearSolver linear_solver = LinearSolver::automatic;
+  double linear_tolerance = 1e-12;  ///< relative residual of iterative solves
+};
+
+struct TimeControl {
+  double end = 1.0;  ///< s, required
+  Scheme scheme = Scheme::explicit_scheme;
+  std::optional<double> dt;  ///< s; absent: automatic
+  /// quasi_static only: geometric growth instead of a fixed dt (dt absent).
+  std::optional<StepGrowth> growth;
+  double courant = 0.5;  ///< factor on the stable step when dt is automatic
+  ImplicitControl implicit;
+};
+
+/// The contract name of a scheme ("explicit", "semi_implicit", "quasi_static").
+inline const char* scheme_name(Scheme s) {
+  switch (s) {
+    case Scheme::semi_implicit:
+      return "semi_implicit";
+    case Scheme::quasi_static:
+      return "quasi_static";
+    case Scheme::explicit_scheme:
+      break;
+  }
+  return "explicit";
+}
 
 struct OutputRequest {
   std::vector<std::int64_t> series_particles;  ///< global particle indices

@@ -59,6 +59,12 @@ struct StableStep {
   double limit = 0.0;       ///< min of the two (Courant factor 1)
   double chosen = 0.0;      ///< the dt the run will use
   double wave_speed = 0.0;  ///< m/s, fastest material
+  /// Steps to time.end: ceil(end / chosen) for a fixed dt; the scheme's
+  /// count for a growing one (quasi_static).
+  std::int64_t steps = 0;
+  /// true when every step is `chosen` long (the last one ends at time.end);
+  /// false when the scheme picks each step (quasi_static growth/automatic).
+  bool fixed = true;
 };
 
 /// Estimates the stable step for `problem` (automatic or user dt).
@@ -160,8 +166,17 @@ struct RunResult {
   std::int64_t nodes = 0;
   double solve_seconds = 0.0;  ///< wall time of the time loop only
   double particle_steps_per_second = 0.0;
-  std::int64_t state_bytes = 0;  ///< particle + grid state in memory
-  int threads = 1;               ///< solver threads actually used
+  std::int64_t state_bytes = 0;     ///< particle + grid state in memory
+  int threads = 1;                  ///< solver threads actually used
+  std::string scheme = "explicit";  ///< scheme_name() of the run's scheme
+  /// Implicit schemes: their iteration counts (zero for the explicit one).
+  struct Iterations {
+    std::int64_t nonlinear = 0;  ///< Newton iterations, all steps (quasi_static)
+    std::int64_t linear = 0;     ///< iterations of iterative linear solves (0: direct)
+    std::int64_t solves = 0;     ///< linear systems solved
+    std::int64_t cutbacks = 0;   ///< steps halved because Newton did not converge
+    int max_nonlinear = 0;       ///< most Newton iterations in one step
+  } iterations;
   Series series;
 };
 

@@ -3,17 +3,23 @@
 //
 // A scheme owns what differs between integrators: how one step t -> t + dt
 // composes the phases of the Simulation (TimeScheme::step), which dt is
-// stable for it (its stable-step rule) and which user dt it refuses (its
-// checks). The time loop (time_loop.hpp) sees only TimeScheme: one virtual
-// call per step, never inside a particle or node loop. Problem-level rules
-// that need no Simulation (the public stable_step() and check_problem())
-// reach the scheme through SchemeRules.
+// stable for it (its stable-step rule), how long each step is when it picks
+// them (next_dt), which user input it refuses (its checks) and the
+// iteration counts it reports. The time loop (time_loop.hpp) sees only
+// TimeScheme: a few virtual calls per step, never inside a particle or node
+// loop. Problem-level rules that need no Simulation (the public
+// stable_step() and check_problem()) reach the scheme through SchemeRules.
 //
-// Schemes: explicit_scheme.hpp (forward Euler u-p, MUSL). A semi-implicit or
-// quasi-static scheme is a peer file here with its own rules, added to
-// scheme_rules() and to the instantiation in time_loop.hpp.
+// Schemes, one peer file each with its rules beside it:
+//   explicit_scheme.hpp      + explicit_rules.cpp       forward Euler u-p, MUSL
+//   semi_implicit_scheme.hpp + semi_implicit_rules.cpp  explicit momentum, implicit pressure
+//   quasi_static_scheme.hpp  + quasi_static_rules.cpp   implicit u-p without inertia
+// A new scheme adds its enum value (hmpm::Scheme, problem.hpp), a case in
+// scheme_rules() (schemes/rules.cpp) and in make_scheme() (time_loop.hpp).
 #pragma once
 
+#include <cmath>
+#include <cstdint>
 #include <vector>
 
 #include "hmpm/problem.hpp"
@@ -27,9 +33,15 @@ class TimeScheme {
   virtual ~TimeScheme() = default;
   /// The stable step of `problem` under this scheme, and the dt chosen.
   virtual StableStep stable_step(const Problem& problem) const = 0;
+  /// Length of the step that starts at t, for schemes whose steps vary
+  /// (StableStep::fixed false); the loop shortens it to end at time.end.
+  /// Fixed-step schemes are never asked.
+  virtual double next_dt(double /*t*/) { return 0.0; }
   /// Advances the simulation from t to t + dt; failures are recorded in the
   /// simulation (the loop reads them after the step).
   virtual void step(double t, double dt) = 0;
+  /// Adds the scheme's counters (iterations, cut-backs) to the result.
+  virtual void report(RunResult& /*result*/) const {}
 };
 
 /// The rules of a scheme that need only the Problem.
@@ -45,9 +57,14 @@ struct SchemeRules {
 /// The rules of the explicit scheme (schemes/explicit_rules.cpp).
 const SchemeRules& explicit_scheme_rules();
 
-/// The scheme `problem` runs with: today always the explicit one.
-inline const SchemeRules& scheme_rules(const Problem&) {
-  return explicit_scheme_rules();
+/// The rules of the scheme `problem` runs with (problem.time.scheme).
+const SchemeRules& scheme_rules(const Problem& problem);
+
+/// Steps of length dt to reach `end`, the last one shortened to end there.
+inline std::int64_t fixed_step_count(double end, double dt) {
+  if (!(dt > 0) || !(end > 0)) return 1;
+  const double n = std::ceil(end / dt - 1e-9);
+  return n < 1 ? 1 : (n > 9.0e18 ? INT64_MAX : static_cast<std::int64_t>(n));
 }
 
 }  // namespace hmpm

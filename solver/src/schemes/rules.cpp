@@ -1,0 +1,17 @@
+// schemes/rules.cpp — which scheme's rules a Problem runs under.
+#include "hmpm/problem.hpp"
+#include "schemes/time_scheme.hpp"
+
+namespace hmpm {
+
+const SchemeRules& scheme_rules(const Problem& problem) {
+  switch (problem.time.scheme) {
+    case Scheme::semi_implicit:  // added by the semi-implicit scheme
+    case Scheme::quasi_static:   // added by the quasi-static scheme
+    case Scheme::explicit_scheme:
+      break;
+  }
+  return explicit_scheme_rules();
+}
+
+}  // namespace hmpm
