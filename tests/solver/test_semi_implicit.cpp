@@ -152,10 +152,11 @@ TEST(SemiImplicit, TerzaghiRealWaterAtTwentyTimesTheExplicitStep) {
   ASSERT_EQ(s.tv.size(), kTargets.size());
   EXPECT_DOUBLE_EQ(s.result.dt, semi.chosen);
   const double e = max_error(c, s, c.H / c.cells);
-  std::printf("real water, %d cells: max |p - p_exact|/q = %.4g (interior), %lld steps, "
-              "%lld solves, %.2f s\n",
-              c.cells, e, static_cast<long long>(s.result.steps),
-              static_cast<long long>(s.result.iterations.solves), s.seconds);
+  std::printf(
+      "real water, %d cells: max |p - p_exact|/q = %.4g (interior), %lld steps, "
+      "%lld solves, %.2f s\n",
+      c.cells, e, static_cast<long long>(s.result.steps),
+      static_cast<long long>(s.result.iterations.solves), s.seconds);
   EXPECT_LT(e, 0.01);
   EXPECT_EQ(s.result.iterations.solves, s.result.steps);
   EXPECT_EQ(s.result.scheme, "semi_implicit");
@@ -217,10 +218,11 @@ TEST(SemiImplicit, AgreesWithExplicitOnSoftenedFluid) {
   const double skin = c.H / c.cells;
   const double err_semi = max_error(c, semi, skin), err_expl = max_error(e, expl, skin);
   const double diff = max_difference(c, semi, expl, skin);
-  std::printf("softened fluid: explicit error %.4g (%lld steps), semi_implicit error %.4g "
-              "(%lld steps), difference %.4g\n",
-              err_expl, static_cast<long long>(expl.result.steps), err_semi,
-              static_cast<long long>(semi.result.steps), diff);
+  std::printf(
+      "softened fluid: explicit error %.4g (%lld steps), semi_implicit error %.4g "
+      "(%lld steps), difference %.4g\n",
+      err_expl, static_cast<long long>(expl.result.steps), err_semi,
+      static_cast<long long>(semi.result.steps), diff);
   EXPECT_LT(err_semi, err_expl);
   EXPECT_LT(diff, 1.5 * err_expl);
 }
@@ -372,11 +374,12 @@ TEST(SemiImplicit, DISABLED_BenchmarkLinearSolvers) {
       const double sec =
           std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
       EXPECT_EQ(r.status, hmpm::RunStatus::successful) << r.message;
-      std::printf("dim %d, %lld nodes, %s: %.4f s per step, %.1f CG iterations per solve\n", k.dim,
-                  static_cast<long long>(r.nodes),
-                  solver == hmpm::LinearSolver::direct ? "direct" : "iterative",
-                  sec / static_cast<double>(r.steps),
-                  static_cast<double>(r.iterations.linear) / static_cast<double>(r.iterations.solves));
+      std::printf(
+          "dim %d, %lld nodes, %s: %.4f s per step, %.1f CG iterations per solve\n", k.dim,
+          static_cast<long long>(r.nodes),
+          solver == hmpm::LinearSolver::direct ? "direct" : "iterative",
+          sec / static_cast<double>(r.steps),
+          static_cast<double>(r.iterations.linear) / static_cast<double>(r.iterations.solves));
     }
   }
 }

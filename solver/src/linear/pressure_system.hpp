@@ -27,13 +27,13 @@ class PressureSystem {
   /// Unknown counts up to which LinearSolver::automatic factorises (per
   /// dimension of the grid; measured in docs/schemes.md): a sparse Cholesky
   /// of a 1D or 2D grid Laplacian fills in little, a 3D one much more.
-  static constexpr std::int64_t direct_limit_2d = 200000, direct_limit_3d = 30000;
+  static constexpr std::int64_t direct_limit_2d = 200000, direct_limit_3d = 1000;
 
   struct Outcome {
     bool ok = true;
     bool direct = true;
-    int iterations = 0;    ///< conjugate-gradient iterations (0 for direct)
-    double residual = 0;   ///< relative residual of the iterative solve
+    int iterations = 0;   ///< conjugate-gradient iterations (0 for direct)
+    double residual = 0;  ///< relative residual of the iterative solve
   };
 
   /// Starts a system of n unknowns with at most max_entries lower-triangle entries.
@@ -50,8 +50,8 @@ class PressureSystem {
 
   /// Solves A x = b (x: the initial guess of the iterative solver on entry).
   /// `dim` picks the automatic solver's size limit.
-  Outcome solve(Eigen::Ref<const Eigen::VectorXd> b, Eigen::Ref<Eigen::VectorXd> x, LinearSolver choice,
-                double tolerance, int dim);
+  Outcome solve(Eigen::Ref<const Eigen::VectorXd> b, Eigen::Ref<Eigen::VectorXd> x,
+                LinearSolver choice, double tolerance, int dim);
 
   int size() const { return static_cast<int>(a_.rows()); }
 

@@ -98,8 +98,8 @@ inline void Simulation<Dim, Shape>::assemble_pressure_laplacian(double dt, doubl
     stencil_in_step<true, true>(p, s);
     const double vol = particles_.volume[p];
     const double rho = particles_.mass[p] / vol;
-    const double c =
-        vol * (dt * dt / rho + dt * mc.permeability_over_gamma * (1.0 - mc.darcy_inertia_density / rho));
+    const double c = vol * (dt * dt / rho + dt * mc.permeability_over_gamma *
+                                                (1.0 - mc.darcy_inertia_density / rho));
     for (int k = 0; k < StencilT::N; ++k) {
       const std::int64_t i = s.node[k];
       active[i] = 1;

@@ -205,8 +205,7 @@ class SemiImplicitScheme final : public TimeScheme {
   /// friction see the corrected velocity).
   void correct_nodal_momentum(double t, double dt) {
     auto& grid = sim_.grid_;
-    sim_.for_particles(nodal::bit(nodal::remap), [&](const Out& out, std::size_t b,
-                                                     std::size_t e) {
+    sim_.for_particles(nodal::bit(nodal::remap), [&](const Out& out, std::size_t b, std::size_t e) {
       sim_.map_pressure_increment_force(out, b, e);
     });
     const double tol = sim_.mass_tolerance_;
