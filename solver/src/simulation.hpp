@@ -54,6 +54,8 @@ namespace hmpm {
 
 template <int Dim, class Shape>
 class ExplicitScheme;
+template <int Dim, class Shape>
+class SemiImplicitScheme;
 
 template <int Dim, class Shape>
 class Simulation {
@@ -70,6 +72,7 @@ class Simulation {
 
  private:
   friend class ExplicitScheme<Dim, Shape>;
+  friend class SemiImplicitScheme<Dim, Shape>;
 
   // ------------------------------------------------------------ set-up (setup.hpp)
   void setup_grid();
@@ -88,7 +91,7 @@ class Simulation {
   void update_particle_velocities_and_remap(const Out& out, std::size_t begin, std::size_t end,
                                             double dt);
   void compute_remapped_nodal_velocity(double t_new, double dt);
-  template <bool Fluid, bool Plastic>
+  template <bool Fluid, bool Plastic, bool ScatterFlux = true>
   void update_particle_stress_and_fluid_flux(const Out& out, std::size_t begin, std::size_t end,
                                              double dt);
   void update_nodal_pressure(double t_new, double dt);
@@ -96,6 +99,12 @@ class Simulation {
   __attribute__((always_inline)) inline void move_particle(std::size_t p, const StencilT& s,
                                                            double dt);
   static Mat active_stress(const Voigt& s);
+
+  // ------------------------------------------------------------ pressure projection
+  // The semi-implicit scheme's phases (phases/pressure_projection.hpp).
+  void map_predicted_fluid_flux(const Out& out, std::size_t begin, std::size_t end);
+  void assemble_pressure_laplacian(double dt, double* box, std::uint8_t* active);
+  void map_pressure_increment_force(const Out& out, std::size_t begin, std::size_t end);
 
   // ------------------------------------------------------------ threads
   // Thread 0 accumulates nodal sums straight into the grid; every other

@@ -17,9 +17,11 @@ namespace hmpm {
 /// a saturated material). In dry runs (!Fluid) the particles also move
 /// with the Lagrangian nodal velocity; in saturated runs the last phase
 /// moves them. Plastic: some material has a return mapping
-/// (return_to_yield_surface, materials/material.hpp).
+/// (return_to_yield_surface, materials/material.hpp). !ScatterFlux (the
+/// semi-implicit scheme, whose pressure increment is already solved): no
+/// flux is scattered, and the reported Darcy flux is that of p^n + dp.
 template <int Dim, class Shape>
-template <bool Fluid, bool Plastic>
+template <bool Fluid, bool Plastic, bool ScatterFlux>
 inline void Simulation<Dim, Shape>::update_particle_stress_and_fluid_flux(const Out& out,
                                                                           std::size_t begin,
                                                                           std::size_t end,
@@ -37,14 +39,18 @@ inline void Simulation<Dim, Shape>::update_particle_stress_and_fluid_flux(const 
       const double div_v = grad_v.trace();
       Vec grad_p = Vec::Zero(), a = Vec::Zero();
       for (int k = 0; k < StencilT::N; ++k) {
-        grad_p += grid_.pressure[s.node[k]] * s.grad(k);
+        if constexpr (ScatterFlux)
+          grad_p += grid_.pressure[s.node[k]] * s.grad(k);
+        else  // semi-implicit: the increment is known, the Darcy flux is of p^{n+1}
+          grad_p += (grid_.pressure[s.node[k]] + grid_.dp[s.node[k]]) * s.grad(k);
         a += s.w[k] * grid_.accel[s.node[k]];
       }
       const Vec w = -mc.permeability_over_gamma *
                     (grad_p - mc.fluid_density * gravity_ + mc.darcy_inertia_density * a);
       particles_.darcy[p] = w;
-      for (int k = 0; k < StencilT::N; ++k)
-        at<nodal::flux>(out)[s.node[k]] += vol * (s.grad(k).dot(w) - s.w[k] * div_v);
+      if constexpr (ScatterFlux)
+        for (int k = 0; k < StencilT::N; ++k)
+          at<nodal::flux>(out)[s.node[k]] += vol * (s.grad(k).dot(w) - s.w[k] * div_v);
     }
     Voigt de = Voigt::Zero();
     for (int a = 0; a < Dim; ++a) de[a] = grad_v(a, a) * dt;

@@ -15,8 +15,6 @@
 
 namespace hmpm {
 
-namespace {
-
 /// Per material: some body of it has particles. Only those limit the step
 /// (a material no body uses has no wave and no diffusion). When none has
 /// (a Problem check_problem refuses anyway), every material counts.
@@ -32,6 +30,8 @@ std::vector<bool> materials_with_particles(const Problem& problem) {
   if (!any) used.assign(used.size(), true);
   return used;
 }
+
+namespace {
 
 /// The explicit limits over the materials that have particles.
 StableStep explicit_stable_step(const Problem& problem) {

@@ -6,8 +6,9 @@ namespace hmpm {
 
 const SchemeRules& scheme_rules(const Problem& problem) {
   switch (problem.time.scheme) {
-    case Scheme::semi_implicit:  // added by the semi-implicit scheme
-    case Scheme::quasi_static:   // added by the quasi-static scheme
+    case Scheme::semi_implicit:
+      return semi_implicit_scheme_rules();
+    case Scheme::quasi_static:  // added by the quasi-static scheme
     case Scheme::explicit_scheme:
       break;
   }

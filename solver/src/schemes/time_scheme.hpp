@@ -56,6 +56,12 @@ struct SchemeRules {
 
 /// The rules of the explicit scheme (schemes/explicit_rules.cpp).
 const SchemeRules& explicit_scheme_rules();
+/// The rules of the semi-implicit scheme (schemes/semi_implicit_rules.cpp).
+const SchemeRules& semi_implicit_scheme_rules();
+
+/// Per material of `problem`: some body of it has particles (only those
+/// limit a stable step); every material when none has (explicit_rules.cpp).
+std::vector<bool> materials_with_particles(const Problem& problem);
 
 /// The rules of the scheme `problem` runs with (problem.time.scheme).
 const SchemeRules& scheme_rules(const Problem& problem);

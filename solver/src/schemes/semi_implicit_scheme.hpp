@@ -1,0 +1,281 @@
+// schemes/semi_implicit_scheme.hpp — the semi-implicit u-p scheme
+// (internal): explicit momentum, implicit pore pressure.
+//
+// An incremental pressure projection (Chorin type, after Kularathna et al.
+// 2021) inside the explicit scheme's MUSL cycle. The predictor is the
+// explicit step up to the nodal momentum, with the pressure p^n: velocity
+// v*, acceleration a*. The pressure increment dp = p^{n+1} - p^n then
+// solves the mass balance at t + dt,
+//   Q dp/dt = -div v^{n+1} - div w^{n+1},
+// with the increment's own effect substituted: v^{n+1} = v* - dt grad dp/rho
+// and, through Darcy's rho_f a term, w^{n+1} = w* - k/gw (1 - rho_f/rho)
+// grad dp, w* = -k/gw (grad p^n - rho_f b + rho_f a*). On the grid:
+//   [S + L_c] dp = dt F(v*, w*),
+//   S_ii = sum_p N_i Q V (the explicit storage), L_c,ij = sum_p c_p V_p
+//   grad N_i . grad N_j, c_p = dt^2/rho_p + dt k/gw (1 - rho_f/rho_p),
+// F the explicit scheme's flux sum_p V (grad N_i . w* - N_i div v*). The
+// matrix is symmetric positive definite (rho_f < rho). Prescribed-pressure
+// nodes take dp = p(t + dt) - p^n, moved to the right-hand side. The
+// corrector adds the force of dp, sum_p V dp_hat grad N_i, to the nodal
+// momentum and re-applies the velocity constraints; the rest of the step is
+// the explicit MUSL step with dp in place of the explicit increment. Only
+// the skeleton's wave then limits dt (semi_implicit_rules.cpp). Dry runs:
+// the explicit step.
+//
+// Linear algebra: linear/pressure_system.hpp (Eigen sparse LDL^T or
+// conjugate gradients with incomplete Cholesky). Assembly of the Laplacian
+// is serial (over particles, into a per-node box of couplings); the flux
+// and the corrector's force are threaded like the explicit phases.
+#pragma once
+
+#include <Eigen/Core>
+#include <algorithm>
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "boundary/apply.hpp"
+#include "linear/pressure_system.hpp"
+#include "phases/grid.hpp"
+#include "phases/grid_to_particle.hpp"
+#include "phases/particle_to_grid.hpp"
+#include "phases/pore_pressure.hpp"
+#include "phases/pressure_projection.hpp"
+#include "phases/stress_and_flux.hpp"
+#include "schemes/time_scheme.hpp"
+#include "simulation.hpp"
+
+namespace hmpm {
+
+template <int Dim, class Shape>
+class SemiImplicitScheme final : public TimeScheme {
+ public:
+  using Sim = Simulation<Dim, Shape>;
+  using Out = typename Sim::Out;
+  using Vec = typename Sim::Vec;
+  using Box = CouplingBox<Dim, Shape::K>;
+
+  explicit SemiImplicitScheme(Sim& sim) : sim_(sim) {
+    if (!sim_.fluid_) return;
+    const auto n = static_cast<std::size_t>(sim_.grid_.count);
+    box_.assign(n * Box::size, 0.0);
+    active_.assign(n, 0);
+    prescribed_.assign(n, 0);
+    unknown_.assign(n, -1);
+    node_of_.assign(n, 0);
+    rhs_.assign(n, 0.0);
+    x_.assign(n, 0.0);
+    last_dp_.assign(n, 0.0);
+    for (const PressureConstraint& bc : sim_.constraints_.pressure)
+      for (std::int64_t i : bc.nodes) prescribed_[static_cast<std::size_t>(i)] = 1;
+    for (int o = 0; o < Box::size; ++o)
+      node_offset_[static_cast<std::size_t>(o)] = Box::node_offset(o, sim_.grid_.stride);
+  }
+
+  StableStep stable_step(const Problem& problem) const override {
+    return semi_implicit_scheme_rules().stable_step(problem);
+  }
+
+  void step(double t, double dt) override {
+    if (!set_local_damping(t)) return;
+    sim_.clear_grid();
+    map_particles_to_grid();
+    if (sim_.fluid_) {
+      sim_.compute_nodal_pressure(t);
+      map_pore_pressure_force();
+    }
+    sim_.apply_surface_loads(t);
+    sim_.update_nodal_momentum(t, dt);  // the predictor v*, a*
+    if (sim_.fluid_) {
+      if (!solve_pressure_increment(t, dt)) return;
+      correct_nodal_momentum(t, dt);
+    }
+    update_particle_velocities_and_remap(dt);
+    sim_.compute_remapped_nodal_velocity(t + dt, dt);
+    update_particle_stress(dt);
+    if (sim_.fluid_) update_particle_pressure_and_position(dt);
+  }
+
+  void report(RunResult& result) const override {
+    result.iterations.solves += solves_;
+    result.iterations.linear += linear_iterations_;
+  }
+
+ private:
+  bool set_local_damping(double t) {
+    const Problem& problem = sim_.problem_;
+    sim_.damping_ = problem.local_damping ? problem.local_damping(t) : 0.0;
+    if (sim_.damping_ >= 0.0 && sim_.damping_ < 1.0) return true;
+    sim_.fail_run("local_damping is " + Sim::number(sim_.damping_) + " at t = " + Sim::number(t) +
+                      " s, outside [0, 1)",
+                  "keep the local_damping formula between 0 and 1 (exclusive) at all times");
+    return false;
+  }
+
+  /// Assembles and solves [S + L_c] dp = dt F into grid dp; false (a
+  /// failure of the run) when the solve fails.
+  bool solve_pressure_increment(double t, double dt) {
+    auto& grid = sim_.grid_;
+    sim_.for_particles(nodal::bit(nodal::flux), [&](const Out& out, std::size_t b, std::size_t e) {
+      sim_.map_predicted_fluid_flux(out, b, e);
+    });
+    sim_.assemble_pressure_laplacian(dt, box_.data(), active_.data());
+    std::fill(grid.dp.begin(), grid.dp.end(), 0.0);
+    apply_pressure_increment_constraints(sim_.constraints_, grid, t + dt);
+    // Unknowns: active, free nodes with a positive diagonal, in node order.
+    const std::int64_t count = grid.count;
+    int n = 0;
+    for (std::int64_t i = 0; i < count; ++i) {
+      const auto u = static_cast<std::size_t>(i);
+      const bool unknown = active_[u] && !prescribed_[u] &&
+                           grid.storage[u] + box_[u * Box::size + Box::center] > 0.0;
+      unknown_[u] = unknown ? n : -1;
+      if (unknown) node_of_[static_cast<std::size_t>(n++)] = i;
+    }
+    std::fill(rhs_.begin(), rhs_.begin() + n, 0.0);
+    system_.begin(n, static_cast<std::int64_t>(n) * (Box::center + 1));
+    for (std::int64_t i = 0; i < count; ++i) {
+      const auto u = static_cast<std::size_t>(i);
+      if (!active_[u]) continue;
+      active_[u] = 0;
+      double* const row = box_.data() + u * Box::size;
+      const int c = unknown_[u];
+      if (c >= 0) {
+        rhs_[static_cast<std::size_t>(c)] += dt * grid.flux[u];
+        system_.add(c, grid.storage[u] + row[Box::center]);
+      }
+      for (int o = Box::center + 1; o < Box::size; ++o) {
+        const double v = row[o];
+        if (v == 0.0) continue;
+        const std::int64_t j = i + node_offset_[static_cast<std::size_t>(o)];
+        const int cj = unknown_[static_cast<std::size_t>(j)];
+        if (c >= 0 && cj >= 0)
+          system_.add(cj, v);
+        else if (c >= 0 && prescribed_[static_cast<std::size_t>(j)])
+          rhs_[static_cast<std::size_t>(c)] -= v * grid.dp[static_cast<std::size_t>(j)];
+        else if (cj >= 0 && prescribed_[u])
+          rhs_[static_cast<std::size_t>(cj)] -= v * grid.dp[u];
+      }
+      if (c >= 0) system_.end_column();
+      std::fill(row, row + Box::size, 0.0);
+    }
+    if (n == 0) return true;
+    for (int c = 0; c < n; ++c)
+      x_[static_cast<std::size_t>(c)] =
+          last_dp_[static_cast<std::size_t>(node_of_[static_cast<std::size_t>(c)])];
+    Eigen::Map<const Eigen::VectorXd> b(rhs_.data(), n);
+    Eigen::Map<Eigen::VectorXd> x(x_.data(), n);
+    const ImplicitControl& control = sim_.problem_.time.implicit;
+    const PressureSystem::Outcome r =
+        system_.solve(b, x, control.linear_solver, control.linear_tolerance, Dim);
+    ++solves_;
+    linear_iterations_ += r.iterations;
+    if (!r.ok) {
+      std::string what = "the pore pressure system of the semi-implicit step could not be solved (";
+      if (r.direct) {
+        what += "the sparse LDL^T factorisation failed or gave a non-finite increment";
+      } else {
+        what += "conjugate gradients reached a relative residual of ";
+        what += Sim::number(r.residual);
+        what += " after ";
+        what += std::to_string(r.iterations);
+        what += " iterations";
+      }
+      what += ")";
+      std::string hint = "reduce time.dt or time.courant (the stable step estimate is ";
+      hint += Sim::number(sim_.stable_.limit);
+      hint += " s), check moduli, densities and permeabilities for unrealistic values";
+      if (!r.direct) hint += ", or ask for the direct linear solver";
+      sim_.fail_run(std::move(what), std::move(hint));
+      return false;
+    }
+    for (int c = 0; c < n; ++c) {
+      const auto i = static_cast<std::size_t>(node_of_[static_cast<std::size_t>(c)]);
+      grid.dp[i] = x_[static_cast<std::size_t>(c)];
+      last_dp_[i] = grid.dp[i];
+    }
+    return true;
+  }
+
+  /// v^{n+1} = v* + dt f_dp/m, a^{n+1} = a* + f_dp/m, then the velocity
+  /// constraints of the step again (the increment's force acts like any
+  /// other force: prescribed components keep their values, ties and
+  /// friction see the corrected velocity).
+  void correct_nodal_momentum(double t, double dt) {
+    auto& grid = sim_.grid_;
+    sim_.for_particles(nodal::bit(nodal::remap), [&](const Out& out, std::size_t b, std::size_t e) {
+      sim_.map_pressure_increment_force(out, b, e);
+    });
+    const double tol = sim_.mass_tolerance_;
+    sim_.for_nodes([&](std::int64_t b, std::int64_t e) {
+      for (std::int64_t i = b; i < e; ++i) {
+        const double m = grid.mass[i];
+        if (m > tol) {
+          const Vec da = grid.remap[i] / m;
+          grid.accel[i] += da;
+          grid.velocity[i] += dt * da;
+        }
+        grid.remap[i].setZero();
+      }
+    });
+    apply_velocity_constraints(sim_.constraints_, grid, tol, t, dt);
+  }
+
+  // The particle phases, as in the explicit scheme.
+  void map_particles_to_grid() {
+    using namespace nodal;
+    const unsigned sums =
+        bit(mass) | bit(momentum) | bit(force) | (sim_.fluid_ ? bit(storage) | bit(pressure) : 0u);
+    sim_.for_particles(sums, [&](const Out& out, std::size_t b, std::size_t e) {
+      sim_.map_particles_to_grid(out, b, e);
+    });
+  }
+  void map_pore_pressure_force() {
+    sim_.for_particles(nodal::bit(nodal::force), [&](const Out& out, std::size_t b, std::size_t e) {
+      sim_.map_pore_pressure_force(out, b, e);
+    });
+  }
+  void update_particle_velocities_and_remap(double dt) {
+    sim_.for_particles(nodal::bit(nodal::remap), [&](const Out& out, std::size_t b, std::size_t e) {
+      sim_.update_particle_velocities_and_remap(out, b, e, dt);
+    });
+  }
+  void update_particle_stress(double dt) {
+    sim_.for_particles(0u, [&](const Out& out, std::size_t b, std::size_t e) {
+      if (sim_.fluid_) {
+        if (sim_.plastic_)
+          sim_.template update_particle_stress_and_fluid_flux<true, true, false>(out, b, e, dt);
+        else
+          sim_.template update_particle_stress_and_fluid_flux<true, false, false>(out, b, e, dt);
+      } else {
+        if (sim_.plastic_)
+          sim_.template update_particle_stress_and_fluid_flux<false, true>(out, b, e, dt);
+        else
+          sim_.template update_particle_stress_and_fluid_flux<false, false>(out, b, e, dt);
+      }
+    });
+  }
+  void update_particle_pressure_and_position(double dt) {
+    sim_.for_particles(0u, [&](const Out&, std::size_t b, std::size_t e) {
+      sim_.update_particle_pressure_and_position(b, e, dt);
+    });
+  }
+
+  Sim& sim_;
+  PressureSystem system_;
+  // Per node (saturated runs): the Laplacian's couplings (zero between
+  // steps), a saturated stencil touched it this step, a prescribed pressure,
+  // its unknown (-1: none), the right-hand side and solution (first n
+  // entries), the last increment (the iterative solver's initial guess).
+  std::vector<double> box_;
+  std::vector<std::uint8_t> active_, prescribed_;
+  std::vector<int> unknown_;
+  std::vector<std::int64_t> node_of_;
+  std::vector<double> rhs_, x_, last_dp_;
+  std::array<std::int64_t, Box::size> node_offset_{};
+  std::int64_t solves_ = 0, linear_iterations_ = 0;
+};
+
+}  // namespace hmpm
