@@ -54,6 +54,8 @@ namespace hmpm {
 
 template <int Dim, class Shape>
 class ExplicitScheme;
+template <int Dim, class Shape>
+class QuasiStaticScheme;
 
 template <int Dim, class Shape>
 class Simulation {
@@ -70,6 +72,7 @@ class Simulation {
 
  private:
   friend class ExplicitScheme<Dim, Shape>;
+  friend class QuasiStaticScheme<Dim, Shape>;
 
   // ------------------------------------------------------------ set-up (setup.hpp)
   void setup_grid();

@@ -16,6 +16,7 @@
 
 #include "output.hpp"
 #include "schemes/explicit_scheme.hpp"
+#include "schemes/quasi_static_scheme.hpp"
 #include "schemes/time_scheme.hpp"
 #include "simulation.hpp"
 
@@ -25,8 +26,9 @@ namespace hmpm {
 template <int Dim, class Shape>
 std::unique_ptr<TimeScheme> make_scheme(Simulation<Dim, Shape>& sim, const Problem& problem) {
   switch (problem.time.scheme) {
+    case Scheme::quasi_static:
+      return std::make_unique<QuasiStaticScheme<Dim, Shape>>(sim);
     case Scheme::semi_implicit:  // added by the semi-implicit scheme
-    case Scheme::quasi_static:   // added by the quasi-static scheme
     case Scheme::explicit_scheme:
       break;
   }

@@ -1,13 +1,15 @@
 // schemes/rules.cpp — which scheme's rules a Problem runs under.
 #include "hmpm/problem.hpp"
+#include "schemes/quasi_static_plan.hpp"
 #include "schemes/time_scheme.hpp"
 
 namespace hmpm {
 
 const SchemeRules& scheme_rules(const Problem& problem) {
   switch (problem.time.scheme) {
+    case Scheme::quasi_static:
+      return quasi_static_scheme_rules();
     case Scheme::semi_implicit:  // added by the semi-implicit scheme
-    case Scheme::quasi_static:   // added by the quasi-static scheme
     case Scheme::explicit_scheme:
       break;
   }
