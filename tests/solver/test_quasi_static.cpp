@@ -9,7 +9,6 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
 #include <limits>
 #include <map>
 #include <vector>
@@ -29,8 +28,11 @@ struct ClayCase {
   int ppc = 2;
   double H = 5.0, E = 5e6, nu = 0.3, porosity = 0.5, k = 1e-9, kw = 2.2e9, q = 50e3;
   double rho_s = 2650;
-  double growth_max_tv = 0.01;  // largest step, in T_v
-  double initial_tv = 1e-5;     // first step, in T_v
+  double growth_max_tv = 0.001;  // largest step, in T_v
+  // First step, in T_v: h^2/(6 c_v) for 40 cells (1.0e-4), the step below
+  // which backward Euler with the consistent coupling matrix overshoots
+  // next to the drained face (Vermeer & Verruijt 1981).
+  double initial_tv = 1e-4;
   double m_v() const { return (1 + nu) * (1 - 2 * nu) / (E * (1 - nu)); }
   double storage() const { return porosity / kw; }
   double cv() const { return k / (1000.0 * 9.81 * (m_v() + storage())); }
@@ -87,8 +89,6 @@ ClayErrors run_clay(const ClayCase& c) {
   const std::vector<double> targets = {0.05, 0.1, 0.2, 0.5, 1.0};
   hmpm::Problem p = clay(c, c.time_of(1.0));
   p.output.series_interval = c.time_of(0.05);
-  if (std::getenv("QS_SHAPE")) p.shape_function = static_cast<hmpm::ShapeFunction>(std::atoi(std::getenv("QS_SHAPE")));
-  if (std::getenv("QS_STAB")) p.time.implicit.pressure_stabilisation = std::atof(std::getenv("QS_STAB"));
   const auto t0 = std::chrono::steady_clock::now();
   ClayErrors e;
   e.result = hmpm::run(p);
@@ -104,27 +104,17 @@ ClayErrors run_clay(const ClayCase& c) {
     for (double target : targets) wanted = wanted || std::abs(tv - target) < 1e-6;
     if (!wanted) continue;
     ++e.times;
-    double settlement = 0, mean_p = 0;
+    double settlement = 0;
     for (std::size_t i = 0; i < np; ++i) {
-      mean_p += s.values[0][row * np + i] / static_cast<double>(np);
       const double z = s.initial_positions[i][axis];
       settlement -= s.values[1][(row * np + i) * 6 + axis];
       if (z < h) continue;  // interior: beyond the cell at the drained face
       const double pe = closed_form::terzaghi_pressure(z, tv, c.H, c.q);
-      if (std::getenv("QS_PROFILE") && std::abs(tv - 0.05) < 1e-6 && (i % 8 == 0 || i > np - 6))
-        std::printf("    z %.4f p %.6f exact %.6f\n", z, s.values[0][row * np + i] / c.q, pe / c.q);
-      const double err = std::abs(s.values[0][row * np + i] - pe) / c.q;
-      if (std::getenv("QS_PROFILE") && err > e.pressure)
-        std::printf("    new max at T_v %.3f particle %zu z %.4f: p %.5f exact %.5f\n", tv, i, z,
-                    s.values[0][row * np + i] / c.q, pe / c.q);
-      e.pressure = std::max(e.pressure, err);
+      e.pressure = std::max(e.pressure, std::abs(s.values[0][row * np + i] - pe) / c.q);
     }
     settlement *= c.H / static_cast<double>(np);  // equal initial volumes
     const double u = settlement / (c.m_v() * c.q * c.H);
     e.degree = std::max(e.degree, std::abs(u - closed_form::terzaghi_degree(tv)));
-    if (std::getenv("HMPM_QS_DEBUG"))
-      std::printf("  T_v %.3f: U %.5f (from p %.5f) exact %.5f, max interior p error so far %.4g\n", tv, u, 1 - mean_p / c.q,
-                  closed_form::terzaghi_degree(tv), e.pressure);
   }
   std::printf(
       "real clay %dD, %d cells x %d ppc, dt up to T_v %.3g: max |p - p_exact|/q = %.4g "
@@ -139,19 +129,18 @@ ClayErrors run_clay(const ClayCase& c) {
 
 // Tolerances (issue 16): pore pressure within 1 % of q in the interior (every
 // particle beyond the first cell at the drained face) at T_v = 0.05, 0.1,
-// 0.2, 0.5, 1, and U within 1 %. Errors: backward Euler is first order, its
-// error on the slowest mode over the run is about (M^2 dt_max)/2 of its
-// amplitude (M^2 = 2.47, dt_max = 0.01 in T_v: 1.2 %, times the mode's
-// amplitude of at most 1.3 q e^{-M^2 T}); the spatial error of 40 linear
-// cells is a few 0.1 % at T_v = 0.05 (explicit Terzaghi test).
+// 0.2, 0.5, 1, and U within 1 %. Measured (40 linear cells, 2 particles
+// per cell, steps growing 1.2x from 1e-4 to 1e-3 in T_v): 0.76 % and 0.23 %.
+// What remains: the time error of backward Euler at the diffusion front at
+// T_v = 0.05 (0.9 % with steps up to 2.5e-3, 1.2 % with 1e-2), and the
+// projection of the initial jump at the drained face onto the slowest mode,
+// of order h/H (the far end starts 0.8 % below q, which decays with that
+// mode). The particles move (the settlement is 0.7 % of H, a third of a
+// cell); with linear shape functions a finer grid makes particles cross
+// cells, which adds the stress noise of cell crossing (docs/schemes.md), so
+// the refinement test below refines the step.
 TEST(QuasiStatic, RealSoftClayOverYears) {
-  ClayCase c;
-  if (std::getenv("QS_DT")) c.growth_max_tv = std::atof(std::getenv("QS_DT"));
-  if (std::getenv("QS_PPC")) c.ppc = std::atoi(std::getenv("QS_PPC"));
-  if (std::getenv("QS_NU")) c.nu = std::atof(std::getenv("QS_NU"));
-  if (std::getenv("QS_KW")) c.kw = std::atof(std::getenv("QS_KW"));
-  if (std::getenv("QS_INIT")) c.initial_tv = std::atof(std::getenv("QS_INIT"));
-  if (std::getenv("QS_CELLS")) c.cells = std::atoi(std::getenv("QS_CELLS"));
+  const ClayCase c;
   const ClayErrors e = run_clay(c);
   EXPECT_EQ(e.times, 5);
   EXPECT_LT(e.pressure, 0.01);
@@ -160,19 +149,21 @@ TEST(QuasiStatic, RealSoftClayOverYears) {
   // the residual confirms convergence).
   EXPECT_EQ(e.result.iterations.max_nonlinear, 1);
   EXPECT_EQ(e.result.iterations.cutbacks, 0);
-  EXPECT_LT(e.result.steps, 200);
+  EXPECT_LT(e.result.steps, 1500);
 }
 
-// Convergence under refinement of the step: halving the largest step must
-// reduce the error (first order in time: the time error dominates at
-// dt_max = 0.04 T_v).
+// Convergence under refinement of the step: with the largest step 0.04 and
+// 0.02 in T_v the error of U (where the time error dominates) must fall by
+// at least a quarter (backward Euler is first order: about half; measured
+// 1.07 % -> 0.36 %), the pressure error must not grow (it is set by the
+// front at T_v = 0.05, where both runs take the same small steps).
 TEST(QuasiStatic, RealSoftClayConvergesWithTheStep) {
   ClayCase coarse;
   coarse.growth_max_tv = 0.04;
   ClayCase fine = coarse;
   fine.growth_max_tv = 0.02;
   const ClayErrors a = run_clay(coarse), b = run_clay(fine);
-  EXPECT_LT(b.pressure, 0.75 * a.pressure);
+  EXPECT_LE(b.pressure, a.pressure);
   EXPECT_LT(b.degree, 0.75 * a.degree);
 }
 
@@ -290,6 +281,14 @@ MandelErrors run_qs_mandel(const QsMandel& c, double T_end, double dT, double T0
   return e;
 }
 
+// Tolerances (issue 16): the centre pressure within 1 % of p0 over t* =
+// 0.002 ... 0.5 (sampled every 0.002, which also brackets the peak at t* =
+// 0.072 / 0.064 to better than 0.1 % of p0), the peak within 1 % of p0, no
+// checkerboard (measure above below 1 %). Measured: 0.37 % / 0.35 %, peaks
+// 1.1056 / 1.0751 p0 against 1.1068 / 1.0763 (verification §10), checkerboard
+// 0.1 % (the boundary layer at the drained face at t* = 0.002 is inside
+// x < a/2 only through the plate). 20 linear cells across a: the first-order
+// time error with steps of 0.002 is 0.1 % over t* = 0.5.
 TEST(QuasiStatic, MandelIncompressible) {
   for (double nu : {0.2, 0.3}) {
     QsMandel c;
@@ -335,12 +334,102 @@ TEST(QuasiStatic, UnconvergedRunFailsWithStepResidualAndAdvice) {
   ASSERT_EQ(r.status, hmpm::RunStatus::failed);
   std::printf("%s\n", r.message.c_str());
   EXPECT_NE(r.message.find("step 1 "), std::string::npos) << r.message;
-  EXPECT_NE(r.message.find("did not converge in 3 iterations after 2 cut-backs"),
-            std::string::npos)
+  EXPECT_NE(r.message.find("did not converge in 3 iterations after 2 cut-backs"), std::string::npos)
       << r.message;
   EXPECT_NE(r.message.find("residual reached"), std::string::npos) << r.message;
   EXPECT_NE(r.message.find("time.implicit.tolerance"), std::string::npos) << r.message;
   EXPECT_NE(r.message.find("smaller step"), std::string::npos) << r.message;
   EXPECT_EQ(r.iterations.cutbacks, 2);
   EXPECT_EQ(r.iterations.solves, 9);  // 3 attempts of 3 iterations
+}
+
+// ------------------------------------------------------------------ large deformation
+// Self-weight consolidation of a very soft 5 m column (E_oed = E = 160 kPa,
+// a weightless pore fluid, see below), drained at the fixed
+// base, starting from zero effective stress (the water carries the weight
+// at t = 0+). The scheme's stress update adds D : sym(grad du) with the
+// gradient on the configuration at the start of each step (plus the
+// Jaumann spin, zero in uniaxial strain), which for small steps integrates
+// to sigma' = E_oed ln(dx/dX) in uniaxial strain: a Hencky-elastic skeleton
+// under Cauchy stress. The drained state of the final geometry: p = 0 and
+// sigma'(X) = -gamma0 (H - X) (gamma0 = rho0 g, the weight per reference
+// volume: mass is conserved), so dx/dX = exp(-gamma0 (H - X)/E) and
+//   x(X) = (E/gamma0) [exp(-gamma0 (H - X)/E) - exp(-gamma0 H/E)],
+// a settlement of 1 - (E/(gamma0 H))(1 - exp(-gamma0 H/E)) = 17.6 % of H.
+// The fluid density is 1e-3 kg/m3 (k scaled to keep k/gamma_w), so the
+// pore pressure is the excess one and vanishes at the drained state; with
+// real water a hydrostatic part would be added. Quadratic B-splines: with
+// linear shape functions the particles crossing cells (here by up to 7
+// cells) leave cells whose particles carry different stress histories but
+// get equal strains, a noise linear MPM cannot remove (docs/schemes.md).
+TEST(QuasiStatic, LargeSettlementEndsDrainedAndConservesSolidMass) {
+  const int cells = 40, ppc = 2;
+  const double H = 5.0, E = 1.6e5, porosity = 0.5, rho_s = 2650, g = 9.81;
+  const double rho0 = (1 - porosity) * rho_s, gamma0 = rho0 * g;
+  const double k_over_gamma = 1e-9 / (1000.0 * 9.81);
+  const double cv = k_over_gamma * E;
+  hmpm::Problem p = problems::column(1, 0, H, cells, ppc);
+  p.shape_function = hmpm::ShapeFunction::bspline;
+  hmpm::Material m;
+  m.name = "very soft clay";
+  m.density = rho_s;
+  m.youngs_modulus = E;
+  m.poisson_ratio = 0.0;
+  m.hydraulic = hmpm::Hydraulic{porosity, k_over_gamma * 1e-3 * 9.81, 2.2e9, 1e-3, inf};
+  p.materials.push_back(m);
+  p.gravity = {-g, 0, 0};
+  p.boundaries.push_back(problems::fixed_velocity(problems::plane(p, 0, 0.0), 0));
+  p.boundaries.push_back(problems::fixed_pressure(problems::plane(p, 0, 0.0), 0.0));
+  p.time.scheme = hmpm::Scheme::quasi_static;
+  p.time.end = 5.0 * H * H / cv;
+  p.time.growth = hmpm::StepGrowth{1e-4 * H * H / cv, 0.02 * H * H / cv, 1.1};
+  p.output.snapshot_interval = p.time.end;
+  p.output.snapshot_fields = {hmpm::Field::position, hmpm::Field::pore_pressure,
+                              hmpm::Field::effective_stress, hmpm::Field::porosity};
+  std::vector<hmpm::Snapshot> snaps;
+  hmpm::RunOptions options;
+  options.on_snapshot = [&](const hmpm::Snapshot& s) { snaps.push_back(s); };
+  const hmpm::RunResult r = hmpm::run(p, options);
+  ASSERT_EQ(r.status, hmpm::RunStatus::successful) << r.message;
+  ASSERT_EQ(snaps.size(), 2u);
+  const hmpm::Snapshot &s0 = snaps.front(), &s1 = snaps.back();
+  const std::size_t np = s0.volume.size();
+  auto x_exact = [&](double X) {
+    return E / gamma0 * (std::exp(-gamma0 * (H - X) / E) - std::exp(-gamma0 * H / E));
+  };
+  double solid0 = 0, solid1 = 0, max_p = 0, max_stress = 0, max_x = 0;
+  const double settlement_exact = 1 - E / (gamma0 * H) * (1 - std::exp(-gamma0 * H / E));
+  for (std::size_t i = 0; i < np; ++i) {
+    solid0 += (1 - s0.porosity[i]) * s0.volume[i];
+    solid1 += (1 - s1.porosity[i]) * s1.volume[i];
+    const double X = s0.position[3 * i];
+    max_p = std::max(max_p, std::abs(s1.pore_pressure[i]) / (gamma0 * H));
+    max_stress = std::max(max_stress,
+                          std::abs(s1.effective_stress[6 * i] + gamma0 * (H - X)) / (gamma0 * H));
+    max_x = std::max(max_x, std::abs(s1.position[3 * i] - x_exact(X)) / (settlement_exact * H));
+  }
+  const double X_top = s0.position[3 * (np - 1)];
+  const double settle = (X_top - s1.position[3 * (np - 1)]) / H;
+  const double settle_exact = (X_top - x_exact(X_top)) / H;
+  std::printf(
+      "large settlement: top particle %.3f %% of H (exact %.3f %%); drained: max |p|/(gamma0 H) "
+      "= %.3g, max |sigma' - exact|/(gamma0 H) = %.3g, max |x - x_exact| / settlement = %.3g; "
+      "solid mass change %.3g; %lld steps, %lld solves\n",
+      100 * settle, 100 * settle_exact, max_p, max_stress, max_x,
+      std::abs(solid1 - solid0) / solid0, static_cast<long long>(r.steps),
+      static_cast<long long>(r.iterations.solves));
+  EXPECT_GT(settle, 0.10);
+  EXPECT_LT(std::abs(solid1 - solid0) / solid0, 1e-13);
+  EXPECT_LT(max_p, 1e-4);
+  // Tolerances: the settlement within 3 % of the large-strain answer
+  // (measured 2.7 %; 2.1 % with 80 cells, 1.6 % with 80 cells and 10x
+  // smaller steps: the spatial error of the clamped B-splines at the base,
+  // whose particle is over-compressed by 13 %, and the first-order geometry
+  // update); the small-strain answer gamma0 H / (2 E) = 20 % of H is 12 %
+  // away, so the test tells the two apart. Positions within 5 % of the
+  // settlement everywhere (measured 2.7 %). Particle stresses carry a
+  // cell-crossing noise (up to 0.4 gamma0 H at single particles) that the
+  // positions, integrals of the strain, do not show: not asserted.
+  EXPECT_NEAR(settle, settle_exact, 0.03 * settle_exact);
+  EXPECT_LT(max_x, 0.05);
 }

@@ -14,7 +14,9 @@ struct UpSystem::Solvers {
   Eigen::BiCGSTAB<Eigen::SparseMatrix<double>, Eigen::IncompleteLUT<double>> bicgstab;
 };
 
-void UpSystem::SolversDeleter::operator()(Solvers* s) const { delete s; }
+void UpSystem::SolversDeleter::operator()(Solvers* s) const {
+  delete s;
+}
 
 UpSystem::Solvers* UpSystem::solvers() {
   if (!solvers_) solvers_.reset(new Solvers());

@@ -96,8 +96,7 @@ void check_quasi_static(const Problem& problem, const StableStep&,
       issues.push_back({{"time", "dt", "initial"}, "must be > 0 s, e.g. " + fmt(t.end / 1000)});
     if (!(g.max >= g.initial))
       issues.push_back({{"time", "dt", "max"}, "must be >= initial (" + fmt(g.initial) + " s)"});
-    if (!(g.growth >= 1.0))
-      issues.push_back({{"time", "dt", "growth"}, "must be >= 1 (e.g. 1.2)"});
+    if (!(g.growth >= 1.0)) issues.push_back({{"time", "dt", "growth"}, "must be >= 1 (e.g. 1.2)"});
   }
   const ImplicitControl& c = t.implicit;
   if (!(c.tolerance > 0 && c.tolerance < 1))

@@ -118,10 +118,9 @@ class QuasiStaticScheme final : public TimeScheme {
       if (sim_.failed_) return;
       if (cuts >= c.max_cutbacks) {
         std::ostringstream what;
-        what << "the quasi-static Newton iterations did not converge in "
-             << c.max_iterations << " iterations after " << cuts
-             << " cut-backs (step length down to " << Sim::number(hh)
-             << " s): residual reached |R_u|/|f| = " << Sim::number(last_ru_)
+        what << "the quasi-static Newton iterations did not converge in " << c.max_iterations
+             << " iterations after " << cuts << " cut-backs (step length down to "
+             << Sim::number(hh) << " s): residual reached |R_u|/|f| = " << Sim::number(last_ru_)
              << ", |R_p|/|terms| = " << Sim::number(last_rp_) << " (tolerance "
              << Sim::number(c.tolerance) << ")";
         sim_.fail_run(what.str(),
@@ -380,8 +379,7 @@ class QuasiStaticScheme final : public TimeScheme {
     const double tr = de[0] + de[1] + de[2];
     for (int c = 0; c < 3; ++c) sig[c] += mc.lambda * tr + 2.0 * mc.shear_modulus * de[c];
     for (int c = 3; c < 6; ++c) sig[c] += 2.0 * mc.shear_modulus * de[c];
-    if (sim_.plastic_)
-      return_to_yield_surface(sig, mc, {sim_.particles_.internal.data(), p});
+    if (sim_.plastic_) return_to_yield_surface(sig, mc, {sim_.particles_.internal.data(), p});
   }
 
   /// Residual (rhs_ = scaled R, ref_ = the sums of the magnitudes of its
