@@ -56,6 +56,7 @@ template <int Dim, class Shape>
 class ExplicitScheme;
 template <int Dim, class Shape>
 class SemiImplicitScheme;
+class QuasiStaticScheme;
 
 template <int Dim, class Shape>
 class Simulation {
@@ -73,6 +74,7 @@ class Simulation {
  private:
   friend class ExplicitScheme<Dim, Shape>;
   friend class SemiImplicitScheme<Dim, Shape>;
+  friend class QuasiStaticScheme<Dim, Shape>;
 
   // ------------------------------------------------------------ set-up (setup.hpp)
   void setup_grid();

@@ -17,6 +17,7 @@
 #include "output.hpp"
 #include "schemes/explicit_scheme.hpp"
 #include "schemes/semi_implicit_scheme.hpp"
+#include "schemes/quasi_static_scheme.hpp"
 #include "schemes/time_scheme.hpp"
 #include "simulation.hpp"
 
@@ -28,7 +29,8 @@ std::unique_ptr<TimeScheme> make_scheme(Simulation<Dim, Shape>& sim, const Probl
   switch (problem.time.scheme) {
     case Scheme::semi_implicit:
       return std::make_unique<SemiImplicitScheme<Dim, Shape>>(sim);
-    case Scheme::quasi_static:  // added by the quasi-static scheme
+    case Scheme::quasi_static:
+      return std::make_unique<QuasiStaticScheme<Dim, Shape>>(sim);
     case Scheme::explicit_scheme:
       break;
   }

@@ -218,6 +218,10 @@ struct ImplicitControl {
   int max_cutbacks = 8;     ///< halvings of a step before the run fails
   LinearSolver linear_solver = LinearSolver::automatic;
   double linear_tolerance = 1e-12;  ///< relative residual of iterative solves
+  /// quasi_static: factor on the pressure-projection stabilisation tau =
+  /// 1/(2G) of equal-order u-p (docs/schemes.md); 0 turns it off (tests only:
+  /// near-incompressible water then shows the checkerboard it removes).
+  double pressure_stabilisation = 1.0;
 };
 
 struct TimeControl {

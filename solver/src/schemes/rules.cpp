@@ -1,5 +1,6 @@
 // schemes/rules.cpp — which scheme's rules a Problem runs under.
 #include "hmpm/problem.hpp"
+#include "schemes/quasi_static_plan.hpp"
 #include "schemes/time_scheme.hpp"
 
 namespace hmpm {
@@ -8,7 +9,8 @@ const SchemeRules& scheme_rules(const Problem& problem) {
   switch (problem.time.scheme) {
     case Scheme::semi_implicit:
       return semi_implicit_scheme_rules();
-    case Scheme::quasi_static:  // added by the quasi-static scheme
+    case Scheme::quasi_static:
+      return quasi_static_scheme_rules();
     case Scheme::explicit_scheme:
       break;
   }

@@ -1,0 +1,591 @@
+// schemes/quasi_static_scheme.hpp — the quasi-static implicit u-p scheme
+// (internal).
+//
+// No inertia; backward Euler in time; Newton iterations; updated-Lagrangian
+// MPM (each step maps the particles to a fresh grid, solves on it, moves the
+// particles and forgets the grid). Unknowns of the step t -> t + dt: the
+// nodal displacement increment du and the nodal pore pressure p = p^{n+1},
+// both with the grid's shape functions N (equal order). With material-point
+// integration over the configuration at the start of the step (x^n, V^n):
+//
+//   R_u = sum_p [ N m_p g - V_p B^T (sigma'(du) - p_hat m) ] + tractions(t + dt)    = 0
+//   R_p = sum_p V_p [ N Q (p_hat - p_p^n) + N div du
+//                     + dt grad N . (k/gamma_w)(grad p_hat - rho_f g) ]
+//         + tau sum_cells int (dp - Pi dp) (q - Pi q) dV                            = 0
+//
+// p_hat = N p, dp = p - p^n (p^n the nodal projection of the particle
+// pressures), sigma'(du) = sigma'^n + Jaumann spin + D : sym(grad du)
+// followed by the material's return mapping. The last term is the
+// polynomial pressure projection (Bochev & Dohrmann 2006; in MPM Zhao &
+// Choo 2020): Pi the volume-weighted mean over the particles of a cell
+// (particles sharing one stencil anchor), tau = 1 / (2G) times
+// time.implicit.pressure_stabilisation. It acts like a compressibility
+// 1/(2G), of the order of the skeleton's own compliance, on the part of the
+// pressure increment that varies inside a cell (the equal-order checkerboard
+// mode), and is zero on cell-wise constant increments and at steady state.
+//
+// The Jacobian, with the equations scaled to comparable sizes (E_ref the
+// largest constrained modulus, unknowns du and p / E_ref, rows R_u / E_ref
+// and R_p), is the symmetric indefinite
+//   [ K / E_ref      -C              ]   K = sum V B^T D B, C = sum V B^T m N
+//   [ -C^T           -E_ref (S + dt H + tau P) ]
+// with the elastic D (exact for elastic materials; plastic points use the
+// elastic tangent too until the algorithmic tangents exist, so Newton
+// converges linearly there).
+//
+// Boundary conditions: prescribed velocity components give prescribed
+// increments (the trapezoidal integral of the velocity over the step),
+// rigid ties share one degree of freedom per tied axis (prescribed
+// components win, as in boundary/apply.hpp), friction walls act as
+// frictionless (only their normal component is prescribed), prescribed pore
+// pressures take their value at t + dt.
+//
+// A step whose Newton iterations do not converge within max_iterations is
+// halved and retried, up to max_cutbacks halvings; then the run fails with
+// the residual reached and what to change.
+#pragma once
+
+#include <Eigen/Core>
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <sstream>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "boundary/apply.hpp"
+#include "boundary/tractions.hpp"
+#include "linear/up_system.hpp"
+#include "materials/material.hpp"
+#include "objective_rate.hpp"
+#include "schemes/quasi_static_plan.hpp"
+#include "schemes/time_scheme.hpp"
+#include "simulation.hpp"
+
+namespace hmpm {
+
+template <int Dim, class Shape>
+class QuasiStaticScheme final : public TimeScheme {
+ public:
+  using Sim = Simulation<Dim, Shape>;
+  using Vec = VecD<Dim>;
+  using Mat = Eigen::Matrix<double, Dim, Dim>;
+  using StencilT = shape::Stencil<Dim, Shape>;
+  static constexpr int N = StencilT::N;
+  static constexpr int L = N * (Dim + 1);  ///< local unknowns of one particle
+
+  explicit QuasiStaticScheme(Sim& sim) : sim_(sim) {
+    const Problem& pr = sim_.problem_;
+    if (!pr.time.dt) {
+      growth_ = quasi_static_growth(pr);
+      nominal_ = growth_.initial;
+    }
+    for (const MaterialConstants& mc : sim_.constants_)
+      e_ref_ = std::max(e_ref_, mc.constrained_modulus);
+    if (!(e_ref_ > 0)) e_ref_ = 1.0;
+  }
+
+  StableStep stable_step(const Problem& problem) const override {
+    return quasi_static_scheme_rules().stable_step(problem);
+  }
+
+  /// The nominal step (grown geometrically), shortened to land on the next
+  /// output instant, or stretched by up to a quarter to reach it.
+  double next_dt(double t) override {
+    double h = nominal_;
+    const OutputRequest& out = sim_.problem_.output;
+    for (double interval : {out.series_interval, out.snapshot_interval}) {
+      if (!(interval > 0)) continue;
+      const double next = (std::floor(t / interval + 1e-9) + 1.0) * interval;
+      if (t + 1.25 * h >= next - 1e-9 * interval) h = std::min(h * 1.25, next - t);
+    }
+    nominal_ = std::min(growth_.max, nominal_ * growth_.growth);
+    return h;
+  }
+
+  void step(double t, double dt) override {
+    const ImplicitControl& c = sim_.problem_.time.implicit;
+    const double t_end = t + dt;
+    double t_cur = t, h = dt;
+    int cuts = 0;
+    while (t_cur < t_end - 1e-12 * dt) {
+      const double hh = std::min(h, t_end - t_cur);
+      if (attempt(t_cur, hh)) {
+        t_cur += hh;
+        continue;
+      }
+      if (sim_.failed_) return;
+      if (cuts >= c.max_cutbacks) {
+        std::ostringstream what;
+        what << "the quasi-static Newton iterations did not converge in " << c.max_iterations
+             << " iterations after " << cuts << " cut-backs (step length down to "
+             << Sim::number(hh) << " s): residual reached |R_u|/|f| = " << Sim::number(last_ru_)
+             << ", |R_p|/|terms| = " << Sim::number(last_rp_) << " (tolerance "
+             << Sim::number(c.tolerance) << ")";
+        sim_.fail_run(what.str(),
+                      "start with a smaller step (time.dt, or time.dt.initial with growth), "
+                      "loosen time.implicit.tolerance, or allow more "
+                      "time.implicit.max_iterations or time.implicit.max_cutbacks");
+        return;
+      }
+      ++cuts;
+      ++cutbacks_;
+      h = 0.5 * hh;
+    }
+    // After cut-backs the next steps start again from the length that worked.
+    if (cuts > 0 && !sim_.problem_.time.dt) nominal_ = std::min(nominal_, h);
+  }
+
+  void report(RunResult& result) const override {
+    result.iterations.nonlinear = nonlinear_;
+    result.iterations.linear = system_.linear_iterations;
+    result.iterations.solves = system_.solves;
+    result.iterations.cutbacks = cutbacks_;
+    result.iterations.max_nonlinear = max_nonlinear_;
+  }
+
+ private:
+  // ------------------------------------------------------------ the step's grid
+  /// Stencils, active nodes, the projection of the particle pressures, the
+  /// cells of the stabilisation and the sparsity pattern, for the particles
+  /// where they are now (once per step; cut-backs reuse them).
+  void prepare() {
+    auto& grid = sim_.grid_;
+    auto& parts = sim_.particles_;
+    const auto nodes = static_cast<std::size_t>(grid.count);
+    const std::size_t np = parts.size();
+    weight_.assign(nodes, 0.0);
+    weight_fluid_.assign(nodes, 0.0);
+    pn_.assign(nodes, 0.0);
+    double vmax = 0.0;
+    StencilT s;
+    keys_.resize(np);
+    for (std::size_t p = 0; p < np; ++p) {
+      sim_.template stencil_in_step<true, false>(p, s);
+      const double vol = parts.volume[p];
+      vmax = std::max(vmax, vol);
+      const bool sat = sim_.fluid_ && sim_.constants_[parts.material[p]].saturated;
+      for (int k = 0; k < N; ++k) {
+        weight_[s.node[k]] += s.w[k] * vol;
+        if (sat) {
+          weight_fluid_[s.node[k]] += s.w[k] * vol;
+          pn_[s.node[k]] += s.w[k] * vol * parts.pressure_out[p];
+        }
+      }
+      keys_[p] = {s.node[0], static_cast<std::int64_t>(p)};
+    }
+    const double tiny = 1e-12 * vmax;
+    for (std::size_t i = 0; i < nodes; ++i)
+      pn_[i] = weight_fluid_[i] > tiny ? pn_[i] / weight_fluid_[i] : 0.0;
+    // Degrees of freedom: prescribed components, then rigid ties, then free.
+    udof_.assign(nodes * Dim, -1);
+    pdof_.assign(nodes, -1);
+    ufixed_.assign(nodes * Dim, 0);
+    for (const VelocityConstraint& bc : sim_.constraints_.velocity)
+      for (int a = 0; a < Dim; ++a)
+        if (bc.fixed[a])
+          for (std::int64_t i : bc.nodes) ufixed_[static_cast<std::size_t>(i) * Dim + a] = 1;
+    std::int64_t n = 0;
+    for (const RigidTie& tie : sim_.constraints_.rigid_ties)
+      for (int a = 0; a < Dim; ++a) {
+        if (!tie.axes[a]) continue;
+        std::int64_t shared = -1;
+        for (std::int64_t i : tie.nodes) {
+          const std::size_t d = static_cast<std::size_t>(i) * Dim + a;
+          if (ufixed_[d] || !(weight_[static_cast<std::size_t>(i)] > tiny) || udof_[d] >= 0)
+            continue;
+          if (shared < 0) shared = n++;
+          udof_[d] = shared;
+        }
+      }
+    pfixed_.assign(nodes, 0);
+    for (const PressureConstraint& bc : sim_.constraints_.pressure)
+      for (std::int64_t i : bc.nodes) pfixed_[static_cast<std::size_t>(i)] = 1;
+    for (std::size_t i = 0; i < nodes; ++i) {
+      if (!(weight_[i] > tiny)) continue;
+      for (int a = 0; a < Dim; ++a) {
+        const std::size_t d = i * Dim + a;
+        if (!ufixed_[d] && udof_[d] < 0) udof_[d] = n++;
+      }
+      if (weight_fluid_[i] > tiny && !pfixed_[i]) pdof_[i] = n++;
+    }
+    unknowns_ = n;
+    // Stabilisation cells: particles grouped by stencil anchor.
+    std::sort(keys_.begin(), keys_.end());
+    cell_nodes_.clear();
+    cell_matrix_.clear();
+    for (std::size_t b = 0; b < np;) {
+      std::size_t e = b;
+      while (e < np && keys_[e].first == keys_[b].first) ++e;
+      add_cell(b, e);
+      b = e;
+    }
+    // Pattern: every pair of unknowns in one particle's stencil (the cells'
+    // pairs are a subset).
+    system_.begin_pattern(unknowns_);
+    std::int64_t dofs[L];
+    for (std::size_t p = 0; p < np; ++p) {
+      sim_.template stencil_in_step<false, true>(p, s);
+      local_dofs(s, dofs);
+      for (int r = 0; r < L; ++r) {
+        if (dofs[r] < 0) continue;
+        for (int c = 0; c < L; ++c)
+          if (dofs[c] >= 0) system_.add_pattern(dofs[r], dofs[c]);
+      }
+    }
+    system_.finish_pattern(sim_.problem_.time.implicit.linear_solver,
+                           sim_.problem_.time.implicit.linear_tolerance);
+    rhs_.resize(unknowns_);
+    ref_.resize(unknowns_);
+    x_.resize(unknowns_);
+    du_.assign(nodes * Dim, 0.0);
+    p_.assign(nodes, 0.0);
+    prepared_ = true;
+  }
+
+  /// The projection term tau (M - m m^T / V) of the saturated particles
+  /// keys_[b, e) (one stencil anchor).
+  void add_cell(std::size_t b, std::size_t e) {
+    auto& parts = sim_.particles_;
+    const double factor = sim_.problem_.time.implicit.pressure_stabilisation;
+    if (!sim_.fluid_ || !(factor > 0)) return;
+    Eigen::Matrix<double, N, N> m = Eigen::Matrix<double, N, N>::Zero();
+    Eigen::Matrix<double, N, 1> mv = Eigen::Matrix<double, N, 1>::Zero();
+    double vol = 0.0, tau = 0.0;
+    StencilT s;
+    for (std::size_t k = b; k < e; ++k) {
+      const auto p = static_cast<std::size_t>(keys_[k].second);
+      const MaterialConstants& mc = sim_.constants_[parts.material[p]];
+      if (!mc.saturated) continue;
+      sim_.template stencil_in_step<false, true>(p, s);
+      const double v = parts.volume[p];
+      for (int i = 0; i < N; ++i) {
+        mv[i] += v * s.w[i];
+        for (int j = 0; j < N; ++j) m(i, j) += v * s.w[i] * s.w[j];
+      }
+      vol += v;
+      tau = std::max(tau, factor / (2.0 * mc.shear_modulus));
+    }
+    if (!(vol > 0)) return;
+    m -= mv * mv.transpose() / vol;
+    m *= tau;
+    for (int i = 0; i < N; ++i) cell_nodes_.push_back(s.node[i]);
+    for (int i = 0; i < N; ++i)
+      for (int j = 0; j < N; ++j) cell_matrix_.push_back(m(i, j));
+  }
+
+  /// Unknown of each local slot (node k: components 0..Dim-1, then the
+  /// pressure at Dim), -1 where the value is prescribed or the node inactive.
+  void local_dofs(const StencilT& s, std::int64_t* dofs) const {
+    for (int k = 0; k < N; ++k) {
+      const auto i = static_cast<std::size_t>(s.node[k]);
+      for (int a = 0; a < Dim; ++a) dofs[k * (Dim + 1) + a] = udof_[i * Dim + a];
+      dofs[k * (Dim + 1) + Dim] = pdof_[i];
+    }
+  }
+
+  // ------------------------------------------------------------ one attempt
+  /// Newton iterations for the step t -> t + h. True when converged (the
+  /// particles are then updated); false otherwise, with nothing changed.
+  bool attempt(double t, double h) {
+    if (!prepared_) prepare();
+    auto& grid = sim_.grid_;
+    const auto nodes = static_cast<std::size_t>(grid.count);
+    // Prescribed values and the initial guess (du = 0, p = p^n).
+    std::fill(du_.begin(), du_.end(), 0.0);
+    for (const VelocityConstraint& bc : sim_.constraints_.velocity)
+      for (int a = 0; a < Dim; ++a)
+        if (bc.fixed[a]) {
+          const double d = 0.5 * ((*bc.fn[a])(t) + (*bc.fn[a])(t + h)) * h;
+          for (std::int64_t i : bc.nodes) du_[static_cast<std::size_t>(i) * Dim + a] = d;
+        }
+    for (std::size_t i = 0; i < nodes; ++i) p_[i] = pn_[i];
+    for (const PressureConstraint& bc : sim_.constraints_.pressure) {
+      const double v = (*bc.fn)(t + h);
+      for (std::int64_t i : bc.nodes) p_[static_cast<std::size_t>(i)] = v;
+    }
+    // External nodal forces at t + h: tractions (gravity is per particle).
+    for (std::size_t i = 0; i < nodes; ++i) grid.force[i].setZero();
+    apply_dead_loads(t + h);
+    const ImplicitControl& c = sim_.problem_.time.implicit;
+    for (int it = 0;; ++it) {
+      const bool converged = assemble(h, /*jacobian=*/it < c.max_iterations);
+      if (converged) {
+        max_nonlinear_ = std::max(max_nonlinear_, it);
+        commit(h);
+        return !sim_.failed_;
+      }
+      if (it >= c.max_iterations) return false;
+      if (!system_.solve(rhs_, x_)) return false;
+      ++nonlinear_;
+      for (std::size_t i = 0; i < nodes; ++i) {
+        for (int a = 0; a < Dim; ++a) {
+          const std::int64_t d = udof_[i * Dim + a];
+          if (d >= 0) du_[i * Dim + a] += x_[d];
+        }
+        if (pdof_[i] >= 0) p_[i] += e_ref_ * x_[pdof_[i]];
+      }
+    }
+  }
+
+  /// Surface loads at time t as dead loads: the force of each loaded
+  /// particle face is the traction times its initial area (volume0 /
+  /// length0), mapped at the face's current position. (The explicit
+  /// scheme's apply_tractions scales the area with (V/V0)^((d-1)/d), which
+  /// in uniaxial compression lowers the load by the top particle's strain;
+  /// Terzaghi's and Mandel's loads are fixed forces.)
+  void apply_dead_loads(double t) {
+    auto& parts = sim_.particles_;
+    auto& grid = sim_.grid_;
+    StencilT s;
+    for (const TractionLoad& load : sim_.tractions_) {
+      Vec traction;
+      for (int a = 0; a < Dim; ++a)
+        traction[a] = load.source->traction[a] ? load.source->traction[a](t) : 0.0;
+      for (std::size_t k = 0; k < load.particles.size(); ++k) {
+        const auto p = static_cast<std::size_t>(load.particles[k]);
+        const double stretch = std::pow(parts.volume[p] / load.volume0[k], 1.0 / Dim);
+        const double area = load.volume0[k] / load.length0[k];
+        Vec face = parts.x[p];
+        face[load.axis] += load.side * 0.5 * load.length0[k] * stretch;
+        s.compute(face, grid.origin, grid.inv_h, grid.cells, grid.stride,
+                  parts.half_length.empty() ? 0.0 : parts.half_length[p]);
+        for (int n = 0; n < N; ++n) grid.force[s.node[n]] += s.w[n] * area * traction;
+      }
+    }
+  }
+
+  /// The particle's strain increment and trial-then-returned stress for the
+  /// current du; grad du in `g`.
+  void particle_stress(std::size_t p, const StencilT& s, Mat& g, Voigt& de, Voigt& sig) const {
+    g.setZero();
+    for (int k = 0; k < N; ++k) {
+      const auto i = static_cast<std::size_t>(s.node[k]);
+      Vec u;
+      for (int a = 0; a < Dim; ++a) u[a] = du_[i * Dim + a];
+      g.noalias() += u * s.grad(k).transpose();
+    }
+    de.setZero();
+    for (int a = 0; a < Dim; ++a) de[a] = g(a, a);
+    if constexpr (Dim >= 2) de[3] = 0.5 * (g(0, 1) + g(1, 0));
+    if constexpr (Dim == 3) {
+      de[4] = 0.5 * (g(1, 2) + g(2, 1));
+      de[5] = 0.5 * (g(2, 0) + g(0, 2));
+    }
+    const MaterialConstants& mc = sim_.constants_[sim_.particles_.material[p]];
+    sig = sim_.particles_.stress[p];
+    if constexpr (Dim >= 2) rotate_jaumann<Dim>(sig, g, 1.0);
+    const double tr = de[0] + de[1] + de[2];
+    for (int c = 0; c < 3; ++c) sig[c] += mc.lambda * tr + 2.0 * mc.shear_modulus * de[c];
+    for (int c = 3; c < 6; ++c) sig[c] += 2.0 * mc.shear_modulus * de[c];
+    if (sim_.plastic_) return_to_yield_surface(sig, mc, {sim_.particles_.internal.data(), p});
+  }
+
+  /// Residual (rhs_ = scaled R, ref_ = the sums of the magnitudes of its
+  /// terms) and, when `jacobian`, the Jacobian. True when converged.
+  bool assemble(double h, bool jacobian) {
+    auto& parts = sim_.particles_;
+    auto& grid = sim_.grid_;
+    rhs_.setZero();
+    ref_.setZero();
+    if (jacobian) system_.zero_values();
+    const double inv_e = 1.0 / e_ref_;
+    const Vec gravity = sim_.gravity_;
+    // Tractions.
+    for (std::size_t i = 0; i < static_cast<std::size_t>(grid.count); ++i)
+      for (int a = 0; a < Dim; ++a) {
+        const std::int64_t d = udof_[i * Dim + a];
+        if (d < 0) continue;
+        rhs_[d] += grid.force[i][a] * inv_e;
+        ref_[d] += std::abs(grid.force[i][a]) * inv_e;
+      }
+    StencilT s;
+    std::int64_t dofs[L];
+    Eigen::Matrix<double, L, L> a_loc;
+    for (std::size_t p = 0; p < parts.size(); ++p) {
+      sim_.template stencil_in_step<true, true>(p, s);
+      local_dofs(s, dofs);
+      const MaterialConstants& mc = sim_.constants_[parts.material[p]];
+      const bool sat = sim_.fluid_ && mc.saturated;
+      Mat g;
+      Voigt de, sig;
+      particle_stress(p, s, g, de, sig);
+      const double vol = parts.volume[p], m = parts.mass[p];
+      const Mat vs = vol * Sim::active_stress(sig);
+      double p_hat = 0.0, div = g.trace();
+      Vec grad_p = Vec::Zero();
+      if (sat)
+        for (int k = 0; k < N; ++k) {
+          const double pk = p_[static_cast<std::size_t>(s.node[k])];
+          p_hat += s.w[k] * pk;
+          grad_p += pk * s.grad(k);
+        }
+      const double storage = sat ? (1.0 - parts.porosity[p]) * sim_.inv_ks_[parts.material[p]] +
+                                       parts.porosity[p] * sim_.inv_kf_[parts.material[p]]
+                                 : 0.0;
+      const double kg = sat ? mc.permeability_over_gamma : 0.0;
+      const Vec flow = grad_p - mc.fluid_density * gravity;
+      const double p_old = sat ? parts.pressure_out[p] : 0.0;
+      for (int k = 0; k < N; ++k) {
+        const Vec gk = s.grad(k);
+        const Vec fs = vs * gk, fp = (vol * p_hat) * gk, fg = (s.w[k] * m) * gravity;
+        for (int a = 0; a < Dim; ++a) {
+          const std::int64_t d = dofs[k * (Dim + 1) + a];
+          if (d < 0) continue;
+          rhs_[d] += (fg[a] - fs[a] + fp[a]) * inv_e;
+          ref_[d] += (std::abs(fg[a]) + std::abs(fs[a]) + std::abs(fp[a])) * inv_e;
+        }
+        const std::int64_t dp = dofs[k * (Dim + 1) + Dim];
+        if (sat && dp >= 0) {
+          const double r1 = vol * s.w[k] * storage * (p_hat - p_old);
+          const double r2 = vol * s.w[k] * div;
+          const double r3 = h * vol * kg * gk.dot(flow);
+          rhs_[dp] += r1 + r2 + r3;
+          ref_[dp] += std::abs(r1) + std::abs(r2) + std::abs(r3);
+        }
+      }
+      if (!jacobian) continue;
+      // Local Jacobian (elastic tangent), scaled as in the file comment.
+      const double lam = mc.lambda * vol * inv_e, sh = mc.shear_modulus * vol * inv_e;
+      for (int k = 0; k < N; ++k) {
+        const Vec gk = s.grad(k);
+        for (int l = 0; l < N; ++l) {
+          const Vec gl = s.grad(l);
+          const double gg = gk.dot(gl);
+          for (int a = 0; a < Dim; ++a)
+            for (int b = 0; b < Dim; ++b)
+              a_loc(k * (Dim + 1) + a, l * (Dim + 1) + b) =
+                  lam * gk[a] * gl[b] + sh * (gk[b] * gl[a] + (a == b ? gg : 0.0));
+          for (int a = 0; a < Dim; ++a) {
+            a_loc(k * (Dim + 1) + a, l * (Dim + 1) + Dim) = sat ? -vol * gk[a] * s.w[l] : 0.0;
+            a_loc(k * (Dim + 1) + Dim, l * (Dim + 1) + a) = sat ? -vol * s.w[k] * gl[a] : 0.0;
+          }
+          a_loc(k * (Dim + 1) + Dim, l * (Dim + 1) + Dim) =
+              sat ? -e_ref_ * vol * (storage * s.w[k] * s.w[l] + h * kg * gg) : 0.0;
+        }
+      }
+      for (int r = 0; r < L; ++r) {
+        if (dofs[r] < 0) continue;
+        for (int c = 0; c < L; ++c)
+          if (dofs[c] >= 0 && a_loc(r, c) != 0.0) system_.add(dofs[r], dofs[c], a_loc(r, c));
+      }
+    }
+    // Pressure stabilisation on the increment p - p^n.
+    const std::size_t cells = cell_nodes_.size() / N;
+    for (std::size_t cc = 0; cc < cells; ++cc) {
+      const std::int64_t* nd = &cell_nodes_[cc * N];
+      const double* mm = &cell_matrix_[cc * N * N];
+      for (int i = 0; i < N; ++i) {
+        const std::int64_t di = pdof_[static_cast<std::size_t>(nd[i])];
+        if (di < 0) continue;
+        double r = 0.0, ra = 0.0;
+        for (int j = 0; j < N; ++j) {
+          const auto nj = static_cast<std::size_t>(nd[j]);
+          const double term = mm[i * N + j] * (p_[nj] - pn_[nj]);
+          r += term;
+          ra += std::abs(term);
+          const std::int64_t dj = pdof_[nj];
+          if (jacobian && dj >= 0 && mm[i * N + j] != 0.0)
+            system_.add(di, dj, -e_ref_ * mm[i * N + j]);
+        }
+        rhs_[di] += r;
+        ref_[di] += ra;
+      }
+    }
+    // Convergence: each block's residual against the size of its terms.
+    double ru = 0, fu = 0, rp = 0, fp = 0;
+    for (std::size_t i = 0; i < static_cast<std::size_t>(grid.count); ++i) {
+      for (int a = 0; a < Dim; ++a) {
+        const std::int64_t d = udof_[i * Dim + a];
+        if (d < 0) continue;
+        ru += rhs_[d] * rhs_[d];
+        fu += ref_[d] * ref_[d];
+      }
+      const std::int64_t d = pdof_[i];
+      if (d >= 0) {
+        rp += rhs_[d] * rhs_[d];
+        fp += ref_[d] * ref_[d];
+      }
+    }
+    last_ru_ = fu > 0 ? std::sqrt(ru / fu) : 0.0;
+    last_rp_ = fp > 0 ? std::sqrt(rp / fp) : 0.0;
+    const double tol = sim_.problem_.time.implicit.tolerance;
+    return last_ru_ <= tol && last_rp_ <= tol;
+  }
+
+  /// The converged step: particles take the stress, strain, volume,
+  /// porosity, pressure and Darcy velocity of du and p, and move by N du.
+  void commit(double h) {
+    auto& parts = sim_.particles_;
+    auto& grid = sim_.grid_;
+    StencilT s;
+    for (std::size_t p = 0; p < parts.size(); ++p) {
+      sim_.template stencil_in_step<true, true>(p, s);
+      Mat g;
+      Voigt de, sig;
+      particle_stress(p, s, g, de, sig);
+      parts.stress[p] = sig;
+      parts.strain[p] += de;
+      Mat f = Mat::Identity() + g;
+      const double j = f.determinant();
+      if (!(j > 0.0)) sim_.fail_volume(p, j);
+      parts.volume[p] *= j;
+      const MaterialConstants& mc = sim_.constants_[parts.material[p]];
+      Vec dx = Vec::Zero();
+      for (int k = 0; k < N; ++k) {
+        const auto i = static_cast<std::size_t>(s.node[k]);
+        for (int a = 0; a < Dim; ++a) dx[a] += s.w[k] * du_[i * Dim + a];
+      }
+      if (sim_.fluid_ && mc.saturated) {
+        parts.porosity[p] = 1.0 - (1.0 - parts.porosity[p]) / j;
+        double p_hat = 0.0;
+        Vec grad_p = Vec::Zero();
+        for (int k = 0; k < N; ++k) {
+          const double pk = p_[static_cast<std::size_t>(s.node[k])];
+          p_hat += s.w[k] * pk;
+          grad_p += pk * s.grad(k);
+        }
+        parts.pressure[p] = p_hat;
+        parts.pressure_out[p] = p_hat;
+        parts.darcy[p] = -mc.permeability_over_gamma * (grad_p - mc.fluid_density * sim_.gravity_);
+        if (!std::isfinite(p_hat)) sim_.fail_nonfinite(p, "pore pressure");
+      }
+      parts.v[p] = dx / h;
+      Vec& x = parts.x[p];
+      x += dx;
+      bool inside = x.allFinite();
+      for (int a = 0; a < Dim; ++a)
+        inside = inside && x[a] >= grid.origin[a] && x[a] <= sim_.grid_max_[a];
+      if (!inside) {
+        if (!x.allFinite())
+          sim_.fail_nonfinite(p, "displacement");
+        else
+          sim_.fail_left_grid(p);
+      }
+    }
+    prepared_ = false;
+  }
+
+  Sim& sim_;
+  StepGrowth growth_;
+  double nominal_ = 0.0;
+  double e_ref_ = 0.0;
+  bool prepared_ = false;
+  std::int64_t unknowns_ = 0;
+
+  std::vector<double> weight_, weight_fluid_, pn_, du_, p_;
+  std::vector<std::int64_t> udof_, pdof_;
+  std::vector<std::uint8_t> ufixed_, pfixed_;
+  std::vector<std::pair<std::int64_t, std::int64_t>> keys_;  ///< (stencil anchor, particle)
+  std::vector<std::int64_t> cell_nodes_;                     ///< N per stabilisation cell
+  std::vector<double> cell_matrix_;                          ///< N x N per cell
+  Eigen::VectorXd rhs_, ref_, x_;
+  UpSystem system_;
+
+  double last_ru_ = 0.0, last_rp_ = 0.0;
+  std::int64_t nonlinear_ = 0, cutbacks_ = 0;
+  int max_nonlinear_ = 0;
+};
+
+}  // namespace hmpm

@@ -1,0 +1,435 @@
+// The quasi-static implicit u-p scheme (time.scheme = quasi_static,
+// schemes/quasi_static_scheme.hpp): real soft clay over years (verification
+// §9), Mandel with incompressible constituents and the pressure
+// stabilisation (§10), large-deformation consolidation, and the failure of a
+// run that cannot converge.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <map>
+#include <vector>
+
+#include "closed_form.hpp"
+#include "hmpm/run.hpp"
+#include "problems.hpp"
+
+namespace {
+
+constexpr double inf = std::numeric_limits<double>::infinity();
+
+// ------------------------------------------------------------------ real clay
+struct ClayCase {
+  int dim = 1;
+  int cells = 40;
+  int ppc = 2;
+  double H = 5.0, E = 5e6, nu = 0.3, porosity = 0.5, k = 1e-9, kw = 2.2e9, q = 50e3;
+  double rho_s = 2650;
+  double growth_max_tv = 0.001;  // largest step, in T_v
+  // First step, in T_v: h^2/(6 c_v) for 40 cells (1.0e-4), the step below
+  // which backward Euler with the consistent coupling matrix overshoots
+  // next to the drained face (Vermeer & Verruijt 1981).
+  double initial_tv = 1e-4;
+  double m_v() const { return (1 + nu) * (1 - 2 * nu) / (E * (1 - nu)); }
+  double storage() const { return porosity / kw; }
+  double cv() const { return k / (1000.0 * 9.81 * (m_v() + storage())); }
+  double time_of(double tv) const { return tv * H * H / cv(); }
+};
+
+hmpm::Problem clay(const ClayCase& c, double end) {
+  const int axis = c.dim - 1;  // vertical axis: the last one
+  hmpm::Problem p = problems::column(c.dim, axis, c.H, c.cells, c.ppc);
+  hmpm::Material m;
+  m.name = "soft clay";
+  m.density = c.rho_s;
+  m.youngs_modulus = c.E;
+  m.poisson_ratio = c.nu;
+  m.hydraulic = hmpm::Hydraulic{c.porosity, c.k, c.kw, 1000.0, inf};
+  p.materials.push_back(m);
+  const double q = c.q;
+  // The state just after loading: the water carries the load (as in the
+  // explicit Terzaghi test; with Kw = 2.2 GPa the undrained share of the
+  // skeleton is Q/(m_v + Q) = 0.15 %, which c_v with Q accounts for).
+  p.bodies[0].initial.pore_pressure = [q](const hmpm::Vec3&) { return q; };
+  p.boundaries.push_back(problems::fixed_velocity(problems::plane(p, axis, 0.0), axis));
+  // Drained through the fixed base: a pressure condition acts on grid nodes,
+  // and the loaded top moves by up to 0.8 h over the consolidation, away
+  // from the node plane z = H (which would then drain less and less). The
+  // solution is Terzaghi's with z measured from the base.
+  p.boundaries.push_back(problems::fixed_pressure(problems::plane(p, axis, 0.0), 0.0));
+  hmpm::Traction t;
+  t.particles.min = p.grid.min;
+  t.particles.max = p.grid.max;
+  t.particles.min[axis] = c.H - c.H / (c.cells * c.ppc);
+  t.axis = axis;
+  t.side = +1;
+  t.traction[axis] = problems::constant(-q);
+  p.tractions.push_back(t);
+  p.time.end = end;
+  p.time.scheme = hmpm::Scheme::quasi_static;
+  p.time.growth = hmpm::StepGrowth{c.time_of(c.initial_tv), c.time_of(c.growth_max_tv), 1.2};
+  const auto n = hmpm::count_particles(p);
+  for (std::int64_t i = 0; i < n; ++i) p.output.series_particles.push_back(i);
+  p.output.series_fields = {hmpm::Field::pore_pressure, hmpm::Field::strain};
+  return p;
+}
+
+struct ClayErrors {
+  double pressure = 0;  // max |p - p_exact| / q over interior particles and the times
+  double degree = 0;    // max |U - U_exact|
+  int times = 0;
+  double seconds = 0;
+  hmpm::RunResult result;
+};
+
+ClayErrors run_clay(const ClayCase& c) {
+  const std::vector<double> targets = {0.05, 0.1, 0.2, 0.5, 1.0};
+  hmpm::Problem p = clay(c, c.time_of(1.0));
+  p.output.series_interval = c.time_of(0.05);
+  const auto t0 = std::chrono::steady_clock::now();
+  ClayErrors e;
+  e.result = hmpm::run(p);
+  e.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  EXPECT_EQ(e.result.status, hmpm::RunStatus::successful) << e.result.message;
+  const hmpm::Series& s = e.result.series;
+  const std::size_t np = s.particles.size();
+  const int axis = c.dim - 1;
+  const double h = c.H / c.cells;
+  for (std::size_t row = 0; row < s.time.size(); ++row) {
+    const double tv = s.time[row] / c.time_of(1.0);
+    bool wanted = false;
+    for (double target : targets) wanted = wanted || std::abs(tv - target) < 1e-6;
+    if (!wanted) continue;
+    ++e.times;
+    double settlement = 0;
+    for (std::size_t i = 0; i < np; ++i) {
+      const double z = s.initial_positions[i][axis];
+      settlement -= s.values[1][(row * np + i) * 6 + axis];
+      if (z < h) continue;  // interior: beyond the cell at the drained face
+      const double pe = closed_form::terzaghi_pressure(z, tv, c.H, c.q);
+      e.pressure = std::max(e.pressure, std::abs(s.values[0][row * np + i] - pe) / c.q);
+    }
+    settlement *= c.H / static_cast<double>(np);  // equal initial volumes
+    const double u = settlement / (c.m_v() * c.q * c.H);
+    e.degree = std::max(e.degree, std::abs(u - closed_form::terzaghi_degree(tv)));
+  }
+  std::printf(
+      "real clay %dD, %d cells x %d ppc, dt up to T_v %.3g: max |p - p_exact|/q = %.4g "
+      "(interior), max |U - U_exact| = %.4g over %d times; %lld steps to %.3g years, "
+      "%lld Newton iterations, %lld solves, %.3f s\n",
+      c.dim, c.cells, c.ppc, c.growth_max_tv, e.pressure, e.degree, e.times,
+      static_cast<long long>(e.result.steps), c.time_of(1.0) / (365.25 * 86400),
+      static_cast<long long>(e.result.iterations.nonlinear),
+      static_cast<long long>(e.result.iterations.solves), e.seconds);
+  return e;
+}
+
+// Tolerances (issue 16): pore pressure within 1 % of q in the interior (every
+// particle beyond the first cell at the drained face) at T_v = 0.05, 0.1,
+// 0.2, 0.5, 1, and U within 1 %. Measured (40 linear cells, 2 particles
+// per cell, steps growing 1.2x from 1e-4 to 1e-3 in T_v): 0.76 % and 0.23 %.
+// What remains: the time error of backward Euler at the diffusion front at
+// T_v = 0.05 (0.9 % with steps up to 2.5e-3, 1.2 % with 1e-2), and the
+// projection of the initial jump at the drained face onto the slowest mode,
+// of order h/H (the far end starts 0.8 % below q, which decays with that
+// mode). The particles move (the settlement is 0.7 % of H, a third of a
+// cell); with linear shape functions a finer grid makes particles cross
+// cells, which adds the stress noise of cell crossing (docs/schemes.md), so
+// the refinement test below refines the step.
+TEST(QuasiStatic, RealSoftClayOverYears) {
+  const ClayCase c;
+  const ClayErrors e = run_clay(c);
+  EXPECT_EQ(e.times, 5);
+  EXPECT_LT(e.pressure, 0.01);
+  EXPECT_LT(e.degree, 0.01);
+  // Linear elasticity: one Newton solve per step (the second evaluation of
+  // the residual confirms convergence).
+  EXPECT_EQ(e.result.iterations.max_nonlinear, 1);
+  EXPECT_EQ(e.result.iterations.cutbacks, 0);
+  EXPECT_LT(e.result.steps, 1500);
+}
+
+// Convergence under refinement of the step: with the largest step 0.04 and
+// 0.02 in T_v the error of U (where the time error dominates) must fall by
+// at least a quarter (backward Euler is first order: about half; measured
+// 1.07 % -> 0.36 %), the pressure error must not grow (it is set by the
+// front at T_v = 0.05, where both runs take the same small steps).
+TEST(QuasiStatic, RealSoftClayConvergesWithTheStep) {
+  ClayCase coarse;
+  coarse.growth_max_tv = 0.04;
+  ClayCase fine = coarse;
+  fine.growth_max_tv = 0.02;
+  const ClayErrors a = run_clay(coarse), b = run_clay(fine);
+  EXPECT_LE(b.pressure, a.pressure);
+  EXPECT_LT(b.degree, 0.75 * a.degree);
+}
+
+}  // namespace
+
+// ------------------------------------------------------------------ Mandel
+// Verification §10: incompressible grains and water (B = 1, nu_u = 1/2),
+// the quarter specimen of test_mandel.cpp (symmetry planes x = 0, y = 0,
+// drained lateral face x = a, a rigid smooth impermeable plate tying the top
+// node row), here starting from rest: the plate load F = q a is applied in
+// the first step, whose response is the undrained one (p = p0 = q/2).
+struct QsMandel {
+  double a = 1.0;
+  int cells = 20, rows = 2, ppc = 2;
+  double E = 10e6, nu = 0.2, k = 1e-8, q = 1e4, gamma_w = 1000.0 * 9.81;
+  double stabilisation = 1.0;
+  hmpm::ShapeFunction shape = hmpm::ShapeFunction::linear;
+  double h() const { return a / cells; }
+  double G() const { return E / (2 * (1 + nu)); }
+  double lambda() const { return E * nu / ((1 + nu) * (1 - 2 * nu)); }
+  double c() const { return k / gamma_w * (lambda() + 2 * G()); }
+  double p0() const { return q / 2; }  // F B (1 + nu_u) / (3 a), B = 1, nu_u = 1/2
+  double time_of(double T) const { return T * a * a / c(); }
+};
+
+hmpm::Problem qs_mandel(const QsMandel& c) {
+  const double h = c.h(), a = c.a, b = c.rows * h;
+  hmpm::Problem p;
+  p.dimension = 2;
+  p.shape_function = c.shape;
+  p.grid.max = {a + 2 * h, b + h, 0};
+  p.grid.cells = {c.cells + 2, c.rows + 1, 1};
+  hmpm::Material m;
+  m.name = "soil";
+  m.density = 2650;
+  m.youngs_modulus = c.E;
+  m.poisson_ratio = c.nu;
+  m.hydraulic = hmpm::Hydraulic{0.3, c.k, inf, 1000.0, inf};
+  p.materials.push_back(m);
+  hmpm::Body body;
+  body.box.max = {a, b, 0};
+  body.particles_per_cell = c.ppc;
+  p.bodies.push_back(body);
+  p.boundaries.push_back(problems::fixed_velocity(problems::plane(p, 0, 0.0), 0));
+  p.boundaries.push_back(problems::fixed_velocity(problems::plane(p, 1, 0.0), 1));
+  p.boundaries.push_back(problems::fixed_pressure(problems::plane(p, 0, a), 0.0));
+  hmpm::Boundary plate;
+  plate.nodes = problems::plane(p, 1, b);
+  plate.rigid[1] = true;
+  p.boundaries.push_back(plate);
+  hmpm::Traction t;
+  t.particles.min = {0, b - h / c.ppc, 0};
+  t.particles.max = {a, b, 0};
+  t.axis = 1;
+  t.side = +1;
+  t.traction[1] = problems::constant(-c.q);
+  p.tractions.push_back(t);
+  p.time.scheme = hmpm::Scheme::quasi_static;
+  p.time.implicit.pressure_stabilisation = c.stabilisation;
+  const auto n = hmpm::count_particles(p);
+  for (std::int64_t i = 0; i < n; ++i) p.output.series_particles.push_back(i);
+  p.output.series_fields = {hmpm::Field::pore_pressure};
+  return p;
+}
+
+/// Checkerboard measure: over the particles of the lower particle row with
+/// x < a/2 (where the exact pressure is uniform to 1e-6 p0 at small t*),
+/// max |p_i - (p_{i-1} + p_{i+1})/2| / p0 along x.
+double checkerboard(const hmpm::Series& s, std::size_t row, double p0, double a) {
+  std::map<double, double> line;  // x -> p, lowest particle row
+  const std::size_t np = s.particles.size();
+  double ymin = inf;
+  for (std::size_t i = 0; i < np; ++i) ymin = std::min(ymin, s.initial_positions[i][1]);
+  for (std::size_t i = 0; i < np; ++i)
+    if (s.initial_positions[i][1] < ymin + 1e-9 && s.initial_positions[i][0] < 0.5 * a)
+      line[s.initial_positions[i][0]] = s.values[0][row * np + i];
+  std::vector<double> v;
+  for (const auto& kv : line) v.push_back(kv.second);
+  double worst = 0;
+  for (std::size_t i = 1; i + 1 < v.size(); ++i)
+    worst = std::max(worst, std::abs(v[i] - 0.5 * (v[i - 1] + v[i + 1])) / p0);
+  return worst;
+}
+
+struct MandelErrors {
+  double centre = 0, peak = 0, peak_exact = 0, checker = 0;
+  hmpm::RunResult result;
+};
+
+MandelErrors run_qs_mandel(const QsMandel& c, double T_end, double dT, double T0 = 1e-4) {
+  hmpm::Problem p = qs_mandel(c);
+  p.time.end = c.time_of(T_end);
+  p.time.growth = hmpm::StepGrowth{c.time_of(T0), c.time_of(dT), 1.2};
+  p.output.series_interval = T0 >= dT ? c.time_of(dT) : 0.0;  // 0: every step
+  MandelErrors e;
+  e.result = hmpm::run(p);
+  EXPECT_EQ(e.result.status, hmpm::RunStatus::successful) << e.result.message;
+  const hmpm::Series& s = e.result.series;
+  const std::size_t np = s.particles.size();
+  const closed_form::Mandel exact(c.nu, 0.5, c.a, c.c(), c.p0());
+  for (std::size_t row = 1; row < s.time.size(); ++row) {
+    const double t = s.time[row];
+    const double pc = s.values[0][row * np + 0];  // particle 0: nearest the centre
+    const double pe = exact.pressure(s.initial_positions[0][0], t);
+    e.centre = std::max(e.centre, std::abs(pc - pe) / c.p0());
+    e.peak = std::max(e.peak, pc);
+    e.peak_exact = std::max(e.peak_exact, pe);
+    e.checker = std::max(e.checker, checkerboard(s, row, c.p0(), c.a));
+  }
+  std::printf(
+      "quasi-static mandel nu %.2f, stabilisation %.2g: max |p_c - exact|/p0 = %.4g, peak %.4f "
+      "p0 (closed form %.4f), checkerboard %.3g; %lld steps, %lld solves\n",
+      c.nu, c.stabilisation, e.centre, e.peak / c.p0(), e.peak_exact / c.p0(), e.checker,
+      static_cast<long long>(e.result.steps), static_cast<long long>(e.result.iterations.solves));
+  return e;
+}
+
+// Tolerances (issue 16): the centre pressure within 1 % of p0 over t* =
+// 0.002 ... 0.5 (sampled every 0.002, which also brackets the peak at t* =
+// 0.072 / 0.064 to better than 0.1 % of p0), the peak within 1 % of p0, no
+// checkerboard (measure above below 1 %). Measured: 0.37 % / 0.35 %, peaks
+// 1.1056 / 1.0751 p0 against 1.1068 / 1.0763 (verification §10), checkerboard
+// 0.1 % (the boundary layer at the drained face at t* = 0.002 is inside
+// x < a/2 only through the plate). 20 linear cells across a: the first-order
+// time error with steps of 0.002 is 0.1 % over t* = 0.5.
+TEST(QuasiStatic, MandelIncompressible) {
+  for (double nu : {0.2, 0.3}) {
+    QsMandel c;
+    c.nu = nu;
+    const MandelErrors e = run_qs_mandel(c, 0.5, 0.002);
+    EXPECT_LT(e.centre, 0.01);
+    EXPECT_NEAR(e.peak, e.peak_exact, 0.01 * c.p0());
+    EXPECT_LT(e.checker, 0.01);
+  }
+}
+
+// The checkerboard the stabilisation removes: one step of t* = 1e-6 from
+// rest (the undrained limit, where the flow term that otherwise couples the
+// pressures is 1e-6 of the rest and equal-order pressure with Q = 0 violates
+// the inf-sup condition), on a taller specimen (10 rows) so the interior has
+// room for the mode. Measure: max |p_i - (p_{i-1} + p_{i+1})/2| / p0 along
+// the lowest particle row over x < a/2, where the exact pressure is p0.
+// Measured: 0.25 without the projection term, 4e-7 with it; the centre
+// pressure then equals p0 within 0.5 %.
+TEST(QuasiStatic, MandelCheckerboardWithoutStabilisation) {
+  QsMandel c;
+  c.rows = 10;
+  c.stabilisation = 0.0;
+  const MandelErrors off = run_qs_mandel(c, 1e-6, 1e-6, 1e-6);
+  c.stabilisation = 1.0;
+  const MandelErrors on = run_qs_mandel(c, 1e-6, 1e-6, 1e-6);
+  EXPECT_GT(off.checker, 0.05);
+  EXPECT_LT(on.checker, 1e-3);
+  EXPECT_LT(on.centre, 0.01);
+}
+
+// ------------------------------------------------------------------ failure
+// A tolerance below round-off cannot be met: every step is cut back
+// max_cutbacks times, then the run fails naming the step, the residual
+// reached and what to change.
+TEST(QuasiStatic, UnconvergedRunFailsWithStepResidualAndAdvice) {
+  ClayCase c;
+  hmpm::Problem p = clay(c, c.time_of(0.1));
+  p.time.implicit.tolerance = 1e-300;
+  p.time.implicit.max_iterations = 3;
+  p.time.implicit.max_cutbacks = 2;
+  const hmpm::RunResult r = hmpm::run(p);
+  ASSERT_EQ(r.status, hmpm::RunStatus::failed);
+  std::printf("%s\n", r.message.c_str());
+  EXPECT_NE(r.message.find("step 1 "), std::string::npos) << r.message;
+  EXPECT_NE(r.message.find("did not converge in 3 iterations after 2 cut-backs"), std::string::npos)
+      << r.message;
+  EXPECT_NE(r.message.find("residual reached"), std::string::npos) << r.message;
+  EXPECT_NE(r.message.find("time.implicit.tolerance"), std::string::npos) << r.message;
+  EXPECT_NE(r.message.find("smaller step"), std::string::npos) << r.message;
+  EXPECT_EQ(r.iterations.cutbacks, 2);
+  EXPECT_EQ(r.iterations.solves, 9);  // 3 attempts of 3 iterations
+}
+
+// ------------------------------------------------------------------ large deformation
+// Self-weight consolidation of a very soft 5 m column (E_oed = E = 160 kPa,
+// a weightless pore fluid, see below), drained at the fixed
+// base, starting from zero effective stress (the water carries the weight
+// at t = 0+). The scheme's stress update adds D : sym(grad du) with the
+// gradient on the configuration at the start of each step (plus the
+// Jaumann spin, zero in uniaxial strain), which for small steps integrates
+// to sigma' = E_oed ln(dx/dX) in uniaxial strain: a Hencky-elastic skeleton
+// under Cauchy stress. The drained state of the final geometry: p = 0 and
+// sigma'(X) = -gamma0 (H - X) (gamma0 = rho0 g, the weight per reference
+// volume: mass is conserved), so dx/dX = exp(-gamma0 (H - X)/E) and
+//   x(X) = (E/gamma0) [exp(-gamma0 (H - X)/E) - exp(-gamma0 H/E)],
+// a settlement of 1 - (E/(gamma0 H))(1 - exp(-gamma0 H/E)) = 17.6 % of H.
+// The fluid density is 1e-3 kg/m3 (k scaled to keep k/gamma_w), so the
+// pore pressure is the excess one and vanishes at the drained state; with
+// real water a hydrostatic part would be added. Quadratic B-splines: with
+// linear shape functions the particles crossing cells (here by up to 7
+// cells) leave cells whose particles carry different stress histories but
+// get equal strains, a noise linear MPM cannot remove (docs/schemes.md).
+TEST(QuasiStatic, LargeSettlementEndsDrainedAndConservesSolidMass) {
+  const int cells = 40, ppc = 2;
+  const double H = 5.0, E = 1.6e5, porosity = 0.5, rho_s = 2650, g = 9.81;
+  const double rho0 = (1 - porosity) * rho_s, gamma0 = rho0 * g;
+  const double k_over_gamma = 1e-9 / (1000.0 * 9.81);
+  const double cv = k_over_gamma * E;
+  hmpm::Problem p = problems::column(1, 0, H, cells, ppc);
+  p.shape_function = hmpm::ShapeFunction::bspline;
+  hmpm::Material m;
+  m.name = "very soft clay";
+  m.density = rho_s;
+  m.youngs_modulus = E;
+  m.poisson_ratio = 0.0;
+  m.hydraulic = hmpm::Hydraulic{porosity, k_over_gamma * 1e-3 * 9.81, 2.2e9, 1e-3, inf};
+  p.materials.push_back(m);
+  p.gravity = {-g, 0, 0};
+  p.boundaries.push_back(problems::fixed_velocity(problems::plane(p, 0, 0.0), 0));
+  p.boundaries.push_back(problems::fixed_pressure(problems::plane(p, 0, 0.0), 0.0));
+  p.time.scheme = hmpm::Scheme::quasi_static;
+  p.time.end = 5.0 * H * H / cv;
+  p.time.growth = hmpm::StepGrowth{1e-4 * H * H / cv, 0.02 * H * H / cv, 1.1};
+  p.output.snapshot_interval = p.time.end;
+  p.output.snapshot_fields = {hmpm::Field::position, hmpm::Field::pore_pressure,
+                              hmpm::Field::effective_stress, hmpm::Field::porosity};
+  std::vector<hmpm::Snapshot> snaps;
+  hmpm::RunOptions options;
+  options.on_snapshot = [&](const hmpm::Snapshot& s) { snaps.push_back(s); };
+  const hmpm::RunResult r = hmpm::run(p, options);
+  ASSERT_EQ(r.status, hmpm::RunStatus::successful) << r.message;
+  ASSERT_EQ(snaps.size(), 2u);
+  const hmpm::Snapshot &s0 = snaps.front(), &s1 = snaps.back();
+  const std::size_t np = s0.volume.size();
+  auto x_exact = [&](double X) {
+    return E / gamma0 * (std::exp(-gamma0 * (H - X) / E) - std::exp(-gamma0 * H / E));
+  };
+  double solid0 = 0, solid1 = 0, max_p = 0, max_stress = 0, max_x = 0;
+  const double settlement_exact = 1 - E / (gamma0 * H) * (1 - std::exp(-gamma0 * H / E));
+  for (std::size_t i = 0; i < np; ++i) {
+    solid0 += (1 - s0.porosity[i]) * s0.volume[i];
+    solid1 += (1 - s1.porosity[i]) * s1.volume[i];
+    const double X = s0.position[3 * i];
+    max_p = std::max(max_p, std::abs(s1.pore_pressure[i]) / (gamma0 * H));
+    max_stress = std::max(max_stress,
+                          std::abs(s1.effective_stress[6 * i] + gamma0 * (H - X)) / (gamma0 * H));
+    max_x = std::max(max_x, std::abs(s1.position[3 * i] - x_exact(X)) / (settlement_exact * H));
+  }
+  const double X_top = s0.position[3 * (np - 1)];
+  const double settle = (X_top - s1.position[3 * (np - 1)]) / H;
+  const double settle_exact = (X_top - x_exact(X_top)) / H;
+  std::printf(
+      "large settlement: top particle %.3f %% of H (exact %.3f %%); drained: max |p|/(gamma0 H) "
+      "= %.3g, max |sigma' - exact|/(gamma0 H) = %.3g, max |x - x_exact| / settlement = %.3g; "
+      "solid mass change %.3g; %lld steps, %lld solves\n",
+      100 * settle, 100 * settle_exact, max_p, max_stress, max_x,
+      std::abs(solid1 - solid0) / solid0, static_cast<long long>(r.steps),
+      static_cast<long long>(r.iterations.solves));
+  EXPECT_GT(settle, 0.10);
+  EXPECT_LT(std::abs(solid1 - solid0) / solid0, 1e-13);
+  EXPECT_LT(max_p, 1e-4);
+  // Tolerances: the settlement within 3 % of the large-strain answer
+  // (measured 2.7 %; 2.1 % with 80 cells, 1.6 % with 80 cells and 10x
+  // smaller steps: the spatial error of the clamped B-splines at the base,
+  // whose particle is over-compressed by 13 %, and the first-order geometry
+  // update); the small-strain answer gamma0 H / (2 E) = 20 % of H is 12 %
+  // away, so the test tells the two apart. Positions within 5 % of the
+  // settlement everywhere (measured 2.7 %). Particle stresses carry a
+  // cell-crossing noise (up to 0.4 gamma0 H at single particles) that the
+  // positions, integrals of the strain, do not show: not asserted.
+  EXPECT_NEAR(settle, settle_exact, 0.03 * settle_exact);
+  EXPECT_LT(max_x, 0.05);
+}
