@@ -43,8 +43,7 @@ Calibration calibrate(int threads) {
   const double steps = static_cast<double>(parsed.job->cost.steps);
   const double fixed = cost::scheme_cost(p, Scheme::explicit_scheme, Calibration{0.0, 1, false})
                            .wall_seconds;  // the per-run overhead alone
-  const double work =
-      cost::scheme_cost(p, Scheme::explicit_scheme, unit).wall_seconds - fixed;
+  const double work = cost::scheme_cost(p, Scheme::explicit_scheme, unit).wall_seconds - fixed;
   if (!(work > 0) || !(steps > 0)) return c;
   RunOptions options;
   options.threads = 1;
