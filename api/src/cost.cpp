@@ -34,9 +34,9 @@ std::int64_t to_count(double v) {
 struct WallModel {
   /// A plastic material's return mapping, per particle-step.
   static constexpr double plastic_factor = 1.5;
-  /// A dry particle has no pore pressure, Darcy flux or storage to update
-  /// (the reference is saturated).
-  static constexpr double dry_factor = 0.6;
+  /// GIMP weights (the overlap of the particle's domain with each node's
+  /// support) cost more than B-spline or linear ones.
+  static constexpr double gimp_factor = 1.3;
   /// Per step whatever the size (phases, boundary values, progress).
   static constexpr double step_overhead = 12.0;
   /// Per run (set-up, first touch of the arrays, result files), seconds.
@@ -61,8 +61,8 @@ double particle_weight(const Problem& p, const Material& m) {
   const int d = std::clamp(p.dimension, 1, 3);
   const double per_axis = p.shape_function == ShapeFunction::linear ? 2.0 : 3.0;
   double w = std::pow(per_axis, d) * d / 8.0;
+  if (p.shape_function == ShapeFunction::gimp) w *= WallModel::gimp_factor;
   if (!std::holds_alternative<LinearElastic>(m.plasticity)) w *= WallModel::plastic_factor;
-  if (!m.hydraulic) w *= WallModel::dry_factor;
   return w;
 }
 

@@ -129,7 +129,7 @@ TEST_F(RoutesTest, WallTimeEstimateScalesWithTheServersCalibration) {
   ASSERT_EQ(res->status, 201) << res->body;
   EXPECT_EQ(json_of(res->body)["cost"]["wall_seconds"], slow["cost"]["wall_seconds"]);
   // The model: at least one reference particle-step per step for this
-  // 1D bar (13 particles of weight 1/4 x 0.6 plus the per-step overhead).
+  // 1D bar (13 particles of weight 1/4 plus the per-step overhead of 12).
   EXPECT_GT(slow["cost"]["wall_seconds"].get<double>(), 50 * 1e-3);
 }
 

@@ -50,7 +50,7 @@ struct Limits {
 /// hmpm-server measures it at start-up (`calibrate`); without a measurement
 /// the default is the value measured on the development machine.
 struct Calibration {
-  double seconds_per_particle_step = 1.25e-7;
+  double seconds_per_particle_step = 1.0e-7;
   int threads = 1;        ///< solver threads a job runs with
   bool measured = false;  ///< false: the built-in default
 };
