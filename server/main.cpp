@@ -14,6 +14,7 @@
 #include <thread>
 
 #include "hmpm/api/exit_codes.hpp"
+#include "hmpm/api/job.hpp"
 #include "hmpm/server/options.hpp"
 #include "hmpm/server/service.hpp"
 #include "hmpm/server/store.hpp"
@@ -42,7 +43,12 @@ int main(int argc, char** argv) {
   signal(SIGPIPE, SIG_IGN);  // a client hanging up must not kill the server
 
   try {
-    hmpm::server::Service service(*parsed.config);
+    // The machine speed behind the wall-time estimates of POST /validate
+    // and the 201 of POST /jobs: a fixed small run, well under a second.
+    hmpm::server::ServiceConfig config = *parsed.config;
+    if (config.seconds_per_particle_step <= 0)
+      config.seconds_per_particle_step = hmpm::api::calibrate(1).seconds_per_particle_step;
+    hmpm::server::Service service(config);
     const int port = service.bind();
     if (port < 0) {
       std::cerr << "hmpm-server: cannot listen on " << parsed.config->host << ":"

@@ -23,6 +23,7 @@
 
 #include "hmpm/api/exit_codes.hpp"
 #include "hmpm/api/job.hpp"
+#include "hmpm/format.hpp"
 
 namespace {
 
@@ -42,7 +43,9 @@ extern "C" void on_interrupt(int) {
 const char* const usage_text =
     "usage:\n"
     "  hmpm run SPEC.json --out DIR [--threads N]   run a job locally, write results into DIR\n"
-    "  hmpm validate SPEC.json                      check a job spec, print its cost estimate\n"
+    "  hmpm validate SPEC.json [--calibrate] [--threads N]\n"
+    "                                               check a job spec, print its cost estimate\n"
+    "                                               (--calibrate: measure this machine first)\n"
     "  hmpm spec-keys                               print the parser's tables (JSON)\n"
     "  hmpm --help | --version\n"
     "SPEC may be '-' for standard input.\n"
@@ -101,12 +104,55 @@ std::string format_seconds(double s) {
   return buf;
 }
 
+// One line per scheme: steps and expected wall time (the run's own first).
+void print_schemes(const hmpm::api::CostEstimate& c) {
+  const auto line = [&](const hmpm::api::SchemeCost& s, const char* what) {
+    std::cout << what << " " << hmpm::scheme_name(s.scheme) << ": " << s.steps << " steps ("
+              << (s.fixed ? "dt " : "first dt ") << s.dt << " s), expected wall time "
+              << hmpm::format_significant(s.wall_seconds, 3) << " s\n";
+  };
+  for (const auto& s : c.schemes)
+    if (s.scheme == c.scheme) line(s, "scheme");
+  for (const auto& s : c.schemes)
+    if (s.scheme != c.scheme) line(s, "  with");
+  std::cout << "calibration: "
+            << hmpm::format_significant(c.calibration.seconds_per_particle_step, 3)
+            << " s per particle-step, "
+            << (c.calibration.measured ? "measured on this machine" : "the built-in default")
+            << ", " << c.calibration.threads << " thread(s)\n";
+}
+
 int command_validate(const std::vector<std::string>& args) {
-  if (args.size() != 1) return usage_error("validate takes exactly one SPEC");
+  std::string spec;
+  bool measure = false;
+  int threads = static_cast<int>(std::thread::hardware_concurrency());
+  for (std::size_t i = 0; i < args.size(); ++i) {
+    if (args[i] == "--calibrate") {
+      measure = true;
+    } else if (args[i] == "--threads" && i + 1 < args.size()) {
+      try {
+        std::size_t used = 0;
+        threads = std::stoi(args[++i], &used);
+        if (used != args[i].size() || threads < 1) throw std::invalid_argument("");
+      } catch (const std::exception&) {
+        return usage_error("--threads needs a positive integer, got '" + args[i] + "'");
+      }
+    } else if (spec.empty() && (args[i] == "-" || args[i].rfind("--", 0) != 0)) {
+      spec = args[i];
+    } else {
+      return usage_error("validate takes one SPEC and optionally --calibrate, --threads N");
+    }
+  }
+  if (spec.empty()) return usage_error("validate takes exactly one SPEC");
   hmpm::api::ParseResult result;
-  if (const int rc = load(args[0], result); rc != exit_ok) return rc;
+  if (const int rc = load(spec, result); rc != exit_ok) return rc;
   std::cout << "valid: " << result.job->name << "\n";
+  hmpm::api::Calibration calibration;
+  calibration.threads = std::max(threads, 1);
+  if (measure) calibration = hmpm::api::calibrate(threads);
+  result.job->cost = hmpm::api::estimate_cost(result.job->problem, calibration);
   print_cost(result.job->cost);
+  print_schemes(result.job->cost);
   for (const auto& w : result.job->warnings)
     std::cerr << "hmpm: warning: " << w.path << ": " << w.message << "\n";
   return exit_ok;

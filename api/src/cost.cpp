@@ -1,14 +1,23 @@
 // cost.cpp — what a job will cost, computed before it runs: particles,
-// nodes, steps from the chosen dt, memory and result-file estimates. The
-// parser checks the limits against it; the server shows and stores it.
+// nodes, steps from the chosen dt, memory, result-file estimates, and the
+// steps and expected wall time of every time scheme. The wall-time model
+// and its constants are here and nowhere else (docs/performance.md,
+// "Wall-time estimate"). The parser checks the limits against it; the
+// server shows and stores it.
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <variant>
 
+#include "cost_model.hpp"
 #include "hmpm/api/job.hpp"
+#include "hmpm/format.hpp"
+#include "spec_reader.hpp"
 
 namespace hmpm::api {
 namespace {
+
+constexpr double inf = std::numeric_limits<double>::infinity();
 
 std::int64_t to_count(double v) {
   if (!(v > 0)) return 0;
@@ -16,9 +25,287 @@ std::int64_t to_count(double v) {
   return static_cast<std::int64_t>(v);
 }
 
+// ------------------------------------------------------- the wall-time model
+// Work is counted in reference particle-steps: one particle-step of a 2D,
+// linear-shape, elastic particle on one thread. Calibration gives the
+// seconds one takes on this machine. The explicit constants are fitted on
+// the examples; the implicit ones are first estimates to be replaced by
+// measurements once the schemes run (docs/performance.md).
+struct WallModel {
+  /// A plastic material's return mapping, per particle-step.
+  static constexpr double plastic_factor = 1.5;
+  /// GIMP weights (the overlap of the particle's domain with each node's
+  /// support) cost more than B-spline or linear ones.
+  static constexpr double gimp_factor = 1.3;
+  /// Per step whatever the size (phases, boundary values, progress).
+  static constexpr double step_overhead = 12.0;
+  /// Per run (set-up, first touch of the arrays, result files), seconds.
+  static constexpr double run_overhead_s = 2e-3;
+  /// Parallel efficiency once a run uses more than one thread.
+  static constexpr double parallel_efficiency = 0.8;
+  /// semi_implicit: assembling the pressure equation, per particle-step,
+  /// on top of the explicit phases.
+  static constexpr double pressure_assembly = 2.0;
+  /// A sparse solve of n unknowns costs linear_solve * n^1.5 (2D nested
+  /// dissection / preconditioned CG on a Laplacian-like matrix).
+  static constexpr double linear_solve = 0.1;
+  /// quasi_static: Newton iterations per step, and assembling the u-p
+  /// tangent (per particle and iteration).
+  static constexpr double newton_iterations = 4.0;
+  static constexpr double tangent_assembly = 10.0;
+};
+
+/// Cost of one particle in reference particle-steps: the nodes it talks to
+/// times the components of each, relative to the reference's 4 x 2.
+double particle_weight(const Problem& p, const Material& m) {
+  const int d = std::clamp(p.dimension, 1, 3);
+  const double per_axis = p.shape_function == ShapeFunction::linear ? 2.0 : 3.0;
+  double w = std::pow(per_axis, d) * d / 8.0;
+  if (p.shape_function == ShapeFunction::gimp) w *= WallModel::gimp_factor;
+  if (!std::holds_alternative<LinearElastic>(m.plasticity)) w *= WallModel::plastic_factor;
+  return w;
+}
+
+/// The particles of every body weighted by their cost, and the count.
+struct Work {
+  double weighted = 0.0;  ///< reference particle-steps per step
+  double particles = 0.0;
+};
+
+Work particle_work(const Problem& p) {
+  Work w;
+  for (const Body& b : p.bodies) {
+    Problem one;
+    one.dimension = p.dimension;
+    one.grid = p.grid;
+    one.bodies.push_back(b);
+    one.bodies.back().material = 0;
+    one.materials.push_back(b.material >= 0 && b.material < static_cast<int>(p.materials.size())
+                                ? p.materials[static_cast<std::size_t>(b.material)]
+                                : Material{});
+    const double n = static_cast<double>(count_particles(one));
+    w.particles += n;
+    w.weighted += n * particle_weight(p, one.materials[0]);
+  }
+  return w;
+}
+
+double grid_nodes(const Problem& p) {
+  double nodes = 1;
+  for (int a = 0; a < std::clamp(p.dimension, 1, 3); ++a) nodes *= p.grid.cells[a] + 1.0;
+  return nodes;
+}
+
+/// Expected wall time of `steps` steps of `scheme`.
+double wall_seconds(const Problem& p, Scheme scheme, double steps, const Calibration& cal) {
+  const Work w = particle_work(p);
+  const RunOptions defaults;
+  const double usable =
+      std::floor(w.particles / static_cast<double>(defaults.min_particles_per_thread));
+  const double threads = std::clamp(usable, 1.0, static_cast<double>(std::max(cal.threads, 1)));
+  const double speedup = threads > 1 ? threads * WallModel::parallel_efficiency : 1.0;
+  const double explicit_step = w.weighted / speedup + WallModel::step_overhead;
+  const int d = std::clamp(p.dimension, 1, 3);
+  const double nodes = grid_nodes(p);
+  double per_step = explicit_step;
+  switch (scheme) {
+    case Scheme::explicit_scheme:
+      break;
+    case Scheme::semi_implicit:
+      per_step += WallModel::pressure_assembly * w.weighted / speedup +
+                  WallModel::linear_solve * std::pow(nodes, 1.5);
+      break;
+    case Scheme::quasi_static:
+      per_step = WallModel::newton_iterations *
+                     (WallModel::tangent_assembly * w.weighted / speedup +
+                      WallModel::linear_solve * std::pow(nodes * (d + 1), 1.5)) +
+                 WallModel::step_overhead;
+      break;
+  }
+  return WallModel::run_overhead_s + steps * per_step * cal.seconds_per_particle_step;
+}
+
+// --------------------------------------------------- what limits each step
+/// Materials some body uses.
+std::vector<const Material*> used_materials(const Problem& p) {
+  std::vector<const Material*> out;
+  for (const Body& b : p.bodies)
+    if (b.material >= 0 && b.material < static_cast<int>(p.materials.size()))
+      out.push_back(&p.materials[static_cast<std::size_t>(b.material)]);
+  return out;
+}
+
+double constrained_modulus(const Material& m) {
+  const double nu = m.poisson_ratio;
+  return m.youngs_modulus * (1 - nu) / ((1 + nu) * (1 - 2 * nu));
+}
+
+double mixture_density(const Material& m) {
+  if (!m.hydraulic) return m.density;
+  const double n = m.hydraulic->porosity;
+  return (1 - n) * m.density + n * m.hydraulic->fluid_density;
+}
+
+/// Storage Q = n/Kf + (1 - n)/Ks (1/Pa).
+double storage(const Hydraulic& h) {
+  const double grains = std::isfinite(h.solid_bulk_modulus) && h.solid_bulk_modulus > 0
+                            ? (1 - h.porosity) / h.solid_bulk_modulus
+                            : 0.0;
+  return h.porosity / h.fluid_bulk_modulus + grains;
+}
+
+/// The physical scales of a problem that decide which scheme fits it.
+struct Scales {
+  double h = inf;              ///< smallest cell size, m
+  double length = 0;           ///< largest extent of the bodies, m
+  double skeleton_speed = 0;   ///< max sqrt(E_oed / rho), m/s
+  double consolidation = inf;  ///< min length^2 / c_v, s (inf when dry)
+};
+
+Scales scales(const Problem& p) {
+  Scales s;
+  const int d = std::clamp(p.dimension, 1, 3);
+  for (int a = 0; a < d; ++a) {
+    if (p.grid.cells[a] > 0) s.h = std::min(s.h, (p.grid.max[a] - p.grid.min[a]) / p.grid.cells[a]);
+    for (const Body& b : p.bodies) s.length = std::max(s.length, b.box.max[a] - b.box.min[a]);
+  }
+  for (const Material* m : used_materials(p)) {
+    const double e_oed = constrained_modulus(*m);
+    s.skeleton_speed = std::max(s.skeleton_speed, std::sqrt(e_oed / mixture_density(*m)));
+    if (m->hydraulic) {
+      const double gamma_w = m->hydraulic->fluid_density * p.gravity_constant;
+      const double c_v =
+          m->hydraulic->hydraulic_conductivity / (gamma_w * (1 / e_oed + storage(*m->hydraulic)));
+      if (c_v > 0) s.consolidation = std::min(s.consolidation, s.length * s.length / c_v);
+    }
+  }
+  return s;
+}
+
+/// The semi-implicit limit h / (c_s sqrt(d)), c_s the skeleton's wave speed
+/// with the mixture's inertia (Courant factor 1).
+double skeleton_limit(const Problem& p) {
+  const Scales s = scales(p);
+  if (!(s.skeleton_speed > 0)) return inf;
+  return s.h / (s.skeleton_speed * std::sqrt(std::clamp(p.dimension, 1, 3)));
+}
+
+/// The quasi-static step growth the estimate (and the advice) assumes when
+/// the spec gives none: from T_v = 1e-4 of the fastest consolidation (or
+/// end/100 when dry) up to end/20, growing by 1.25.
+StepGrowth automatic_growth(const Problem& p) {
+  const Scales s = scales(p);
+  const double end = p.time.end;
+  StepGrowth g;
+  g.initial = std::min(std::isfinite(s.consolidation) ? 1e-4 * s.consolidation : inf, end / 100);
+  g.max = std::max(end / 20, g.initial);
+  g.growth = 1.25;
+  return g;
+}
+
+std::string fmt(double v) {
+  return format_significant(v, 3);
+}
+
 }  // namespace
 
-CostEstimate estimate_cost(const Problem& p) {
+namespace cost {
+
+double growth_step_count(double end, const StepGrowth& g) {
+  if (!(g.initial > 0) || !(end > 0)) return 0;
+  const double max = std::max(g.max, g.initial);
+  if (g.growth <= 1 || max <= g.initial) return std::ceil(end / g.initial - 1e-9);
+  // Growing steps until dt reaches max: k, covering initial (g^k - 1)/(g - 1).
+  const double k = std::ceil(std::log(max / g.initial) / std::log(g.growth) - 1e-12);
+  const double covered = g.initial * (std::pow(g.growth, k) - 1) / (g.growth - 1);
+  if (covered >= end)
+    return std::ceil(std::log(1 + end * (g.growth - 1) / g.initial) / std::log(g.growth) - 1e-9);
+  return k + std::ceil((end - covered) / max - 1e-9);
+}
+
+SchemeCost scheme_cost(const Problem& problem, Scheme scheme, const Calibration& calibration) {
+  Problem p = problem;  // shallow enough: the bodies' formulas are shared functions
+  const bool own = scheme == problem.time.scheme;
+  p.time.scheme = scheme;
+  if (!own) {
+    p.time.dt.reset();
+    p.time.growth.reset();
+  }
+  SchemeCost c;
+  c.scheme = scheme;
+  const StableStep s = stable_step(p);
+  double steps = static_cast<double>(s.steps);
+  c.dt = s.chosen;
+  c.fixed = s.fixed;
+  if (!own) {
+    // Until the solver has a scheme's rule, its StableStep is the explicit
+    // one: estimate the scheme's own limit instead.
+    Problem e = p;
+    e.time.scheme = Scheme::explicit_scheme;
+    const StableStep explicit_step = stable_step(e);
+    const bool solver_knows = scheme == Scheme::explicit_scheme || s.limit != explicit_step.limit ||
+                              s.fixed != explicit_step.fixed;
+    if (!solver_knows && scheme == Scheme::semi_implicit) {
+      c.dt = p.time.courant * skeleton_limit(p);
+      steps = std::ceil(p.time.end / c.dt - 1e-9);
+    } else if (!solver_knows && scheme == Scheme::quasi_static) {
+      const StepGrowth g = automatic_growth(p);
+      c.dt = g.initial;
+      c.fixed = false;
+      steps = growth_step_count(p.time.end, g);
+    }
+  }
+  c.steps = to_count(steps);
+  c.wall_seconds = wall_seconds(p, scheme, steps, calibration);
+  return c;
+}
+
+std::string scheme_advice(const Problem& p, std::int64_t max_steps,
+                          const Calibration& calibration) {
+  const Scales s = scales(p);
+  const double limit = static_cast<double>(max_steps);
+  const StableStep current = stable_step(p);
+  const double crossing = s.skeleton_speed > 0 ? s.length / s.skeleton_speed : inf;
+  // Consolidation long compared with any wave: inertia plays no part.
+  if (p.time.scheme != Scheme::quasi_static && p.time.end > 100 * crossing) {
+    const SchemeCost q = scheme_cost(p, Scheme::quasi_static, calibration);
+    if (static_cast<double>(q.steps) <= limit) {
+      const StepGrowth g = automatic_growth(p);
+      std::string a = "use time.scheme 'quasi_static' (no inertia, any step is stable): about " +
+                      format_count(static_cast<double>(q.steps)) +
+                      " steps with dt {\"initial\": " + fmt(g.initial) +
+                      ", \"max\": " + fmt(g.max) + ", \"growth\": " + fmt(g.growth) + "}, about " +
+                      fmt(q.wall_seconds) + " s; the end time is " + fmt(p.time.end / crossing) +
+                      " times the time a skeleton wave takes to cross the soil (" + fmt(s.length) +
+                      " m / " + fmt(s.skeleton_speed) + " m/s = " + fmt(crossing) + " s)";
+      if (std::isfinite(s.consolidation))
+        a += ", and consolidation over " + fmt(s.length) + " m takes about " +
+             fmt(s.consolidation) + " s (H^2/c_v)";
+      return a + " (docs/schemes.md)";
+    }
+  }
+  // Water (its stiffness or the hydraulic diffusion) limits the explicit
+  // step, and the skeleton alone would allow a much larger one.
+  if (p.time.scheme == Scheme::explicit_scheme) {
+    const SchemeCost semi = scheme_cost(p, Scheme::semi_implicit, calibration);
+    if (static_cast<double>(semi.steps) <= limit && semi.dt > 2 * current.chosen) {
+      const std::string what =
+          current.hydraulic < current.mechanical
+              ? "the explicit hydraulic diffusion limit (" + fmt(current.hydraulic) + " s)"
+              : "the undrained wave speed " + fmt(current.wave_speed) + " m/s with the water";
+      return "use time.scheme 'semi_implicit' (pore pressure implicit): about " +
+             format_count(static_cast<double>(semi.steps)) + " steps of " + fmt(semi.dt) +
+             " s, about " + fmt(semi.wall_seconds) +
+             " s; its step is limited by the skeleton's wave speed sqrt(E_oed/rho) = " +
+             fmt(s.skeleton_speed) + " m/s, the explicit one by " + what + " (docs/schemes.md)";
+    }
+  }
+  return "";
+}
+
+}  // namespace cost
+
+CostEstimate estimate_cost(const Problem& p, const Calibration& calibration) {
   CostEstimate c;
   const int dim = std::clamp(p.dimension, 1, 3);
   c.particles = count_particles(p);
@@ -29,9 +316,10 @@ CostEstimate estimate_cost(const Problem& p) {
   }
   c.cells = to_count(cells);
   c.nodes = to_count(nodes);
-  c.dt = stable_step(p).chosen;
-  const double steps = c.dt > 0 ? std::ceil(p.time.end / c.dt - 1e-9) : 0.0;
-  c.steps = to_count(steps);
+  const StableStep step = stable_step(p);
+  c.dt = step.chosen;
+  const double steps = static_cast<double>(step.steps);
+  c.steps = step.steps;
   c.particle_steps = to_count(static_cast<double>(c.particles) * steps);
   c.memory_bytes = to_count(400.0 * static_cast<double>(c.particles) + 100.0 * nodes);
   const OutputRequest& o = p.output;
@@ -59,6 +347,14 @@ CostEstimate estimate_cost(const Problem& p) {
       4096 + rows * (1 + series_values) * 2 * 22 +
       snaps * (static_cast<double>(c.particles) * (snapshot_values * 32.0 / 3.0 + 16) + 4096);
   c.output_bytes = to_count(bytes);
+
+  c.scheme = p.time.scheme;
+  c.calibration = calibration;
+  c.wall_seconds = wall_seconds(p, p.time.scheme, steps, calibration);
+  for (Scheme s : {Scheme::explicit_scheme, Scheme::semi_implicit, Scheme::quasi_static})
+    c.schemes.push_back(s == p.time.scheme
+                            ? SchemeCost{s, c.steps, c.dt, step.fixed, c.wall_seconds}
+                            : cost::scheme_cost(p, s, calibration));
   return c;
 }
 

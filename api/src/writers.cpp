@@ -105,6 +105,17 @@ void write_summary(const fs::path& path, const std::string& job_name, const RunR
   field("steps", std::to_string(run.steps));
   field("end_time", num(run.end_time));
   field("dt", num(run.dt));
+  field("scheme", json_string(run.scheme));
+  if (run.scheme != "explicit") {
+    const RunResult::Iterations& it = run.iterations;
+    std::string i = "{\"nonlinear\": ";
+    i += std::to_string(it.nonlinear);
+    i += ", \"linear\": " + std::to_string(it.linear);
+    i += ", \"solves\": " + std::to_string(it.solves);
+    i += ", \"cutbacks\": " + std::to_string(it.cutbacks);
+    i += ", \"max_nonlinear\": " + std::to_string(it.max_nonlinear) + "}";
+    field("iterations", i);
+  }
   field("particles", std::to_string(run.particles));
   field("nodes", std::to_string(run.nodes));
   field("solve_seconds", num(run.solve_seconds));

@@ -132,6 +132,7 @@ bool Service::run() {
             {"port", s.port},
             {"workers", s.config.workers},
             {"threads_per_job", s.config.threads_per_job},
+            {"seconds_per_particle_step", s.config.seconds_per_particle_step},
             {"db", s.config.db_path.string()},
             {"data_dir", s.config.data_dir.string()},
             {"instance", s.instance_id},

@@ -151,6 +151,33 @@ TEST(Writers, SnapshotsReadBackWithMeshio) {
       << v.err;
 }
 
+TEST(Writers, SummaryNamesTheSchemeAndTheImplicitIterations) {
+  testing::TempDir dir;
+  RunResult run;
+  run.status = RunStatus::successful;
+  run.scheme = "quasi_static";
+  run.iterations.nonlinear = 123;
+  run.iterations.linear = 4567;
+  run.iterations.solves = 130;
+  run.iterations.cutbacks = 2;
+  run.iterations.max_nonlinear = 9;
+  write_summary(dir.path() / "summary.json", "q", run, CostEstimate{}, {});
+  const json s = json::parse(testing::read_text(dir.path() / "summary.json"));
+  EXPECT_EQ(s["scheme"], "quasi_static");
+  EXPECT_EQ(s["iterations"], (json{{"nonlinear", 123},
+                                   {"linear", 4567},
+                                   {"solves", 130},
+                                   {"cutbacks", 2},
+                                   {"max_nonlinear", 9}}));
+  // The explicit scheme has no iterations to report.
+  RunResult plain;
+  plain.status = RunStatus::successful;
+  write_summary(dir.path() / "summary.json", "e", plain, CostEstimate{}, {});
+  const json e = json::parse(testing::read_text(dir.path() / "summary.json"));
+  EXPECT_EQ(e["scheme"], "explicit");
+  EXPECT_FALSE(e.contains("iterations"));
+}
+
 TEST(Writers, EmptySnapshotIsStillAValidFile) {
   testing::TempDir dir;
   write_snapshot_vtu(dir.path() / "snapshot_0000.vtu", synthetic_snapshot(0, 0));
@@ -173,7 +200,7 @@ TEST(RunJob, WritesEveryRequestedFileAndASummary) {
   const json summary = json::parse(testing::read_text(dir.path() / "results" / "summary.json"));
   for (const char* key :
        {"status", "message", "steps", "end_time", "dt", "particles", "nodes", "solve_seconds",
-        "particle_steps_per_second", "warnings", "cost", "name", "hmpm_version"})
+        "particle_steps_per_second", "warnings", "cost", "name", "hmpm_version", "scheme"})
     EXPECT_TRUE(summary.contains(key)) << key;
   EXPECT_EQ(summary["name"], "valid-2d");
   EXPECT_EQ(summary["cost"]["particles"], 48);

@@ -118,6 +118,21 @@ class RoutesTest : public ::testing::Test {
   std::unique_ptr<httplib::Client> client_;
 };
 
+TEST_F(RoutesTest, WallTimeEstimateScalesWithTheServersCalibration) {
+  ServiceConfig c = config();
+  c.seconds_per_particle_step = 1e-3;  // a very slow machine
+  start(c);
+  const Json slow = json_of(client_->Post("/validate", small_spec("s"), "application/json")->body);
+  EXPECT_EQ(slow["cost"]["calibrated"], true);
+  EXPECT_EQ(slow["cost"]["seconds_per_particle_step"], 1e-3);
+  const auto res = client_->Post("/jobs", small_spec("s"), "application/json");
+  ASSERT_EQ(res->status, 201) << res->body;
+  EXPECT_EQ(json_of(res->body)["cost"]["wall_seconds"], slow["cost"]["wall_seconds"]);
+  // The model: at least one reference particle-step per step for this
+  // 1D bar (13 particles of weight 1/4 plus the per-step overhead of 12).
+  EXPECT_GT(slow["cost"]["wall_seconds"].get<double>(), 50 * 1e-3);
+}
+
 const std::regex rfc3339(R"(\d{4}-\d{2}-\d{2}T\d{2}:\d{2}:\d{2}(\.\d+)?Z)");
 
 TEST_F(RoutesTest, SubmitPollAndDownloadResults) {
@@ -751,6 +766,17 @@ TEST_F(RoutesTest, ValidateAnswersValidWithWarningsAndCostOrTheInvalidSpecProble
   const std::string id = submit(small_spec("plain"));
   EXPECT_EQ(json_of(client_->Get(("/jobs/" + id).c_str())->body)["cost"],
             json_of(res->body)["cost"]);
+  // With the expected wall time of each scheme, from the server's
+  // calibration (the built-in default here: the fixture measures none).
+  const Json cost = json_of(res->body)["cost"];
+  EXPECT_EQ(cost["scheme"], "explicit");
+  EXPECT_GT(cost["wall_seconds"].get<double>(), 0.0);
+  EXPECT_EQ(cost["calibrated"], false);
+  ASSERT_EQ(cost["schemes"].size(), 3u);
+  EXPECT_EQ(cost["schemes"][0]["scheme"], "explicit");
+  EXPECT_EQ(cost["schemes"][0]["steps"], cost["steps"]);
+  EXPECT_EQ(cost["schemes"][0]["wall_seconds"], cost["wall_seconds"]);
+  EXPECT_EQ(cost["schemes"][2]["scheme"], "quasi_static");
 
   spec["materials"]["bar"]["youngs_modulus"] = -1;
   Json p = expect_problem(client_->Post("/validate", spec.dump(), "application/json"), 400,

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "cost_model.hpp"
 #include "parser.hpp"
 
 namespace hmpm::api::parse {
@@ -167,15 +168,19 @@ void check_limits(ParseContext& c) {
   const Limits& limits = c.limits;
   const CostEstimate cost = estimate_cost(p);
   const StableStep s = stable_step(p);
-  const double steps = std::ceil(p.time.end / s.chosen - 1e-9);
+  const double steps = static_cast<double>(s.steps);
   if (steps > static_cast<double>(limits.max_steps)) {
-    const std::string why =
-        p.time.dt ? "end " + format_number(p.time.end) + " s / dt " + format_number(s.chosen) + " s"
-                  : "end " + format_number(p.time.end) + " s / automatic dt " +
-                        format_number(s.chosen) + " s";
-    c.r.error(p.time.dt ? "/time/dt" : "/time/end", "the run needs " + format_count(steps) +
-                                                        " time steps (" + why + "); the limit is " +
-                                                        std::to_string(limits.max_steps));
+    std::string why = "end " + format_number(p.time.end) + " s / ";
+    why += p.time.dt ? "dt " : (s.fixed ? "automatic dt " : "first dt ");
+    why += format_number(s.chosen) + " s with scheme '" + scheme_name(p.time.scheme) + "'";
+    std::string message = "the run needs " + format_count(steps) + " time steps (" + why +
+                          "); the limit is " + std::to_string(limits.max_steps);
+    const std::string advice = cost::scheme_advice(p, limits.max_steps, cost.calibration);
+    if (advice.empty())
+      message += "; shorten time.end or use a coarser grid";
+    else
+      message += "; " + advice;
+    c.r.error(p.time.dt || p.time.growth ? "/time/dt" : "/time/end", message);
   }
   if (cost.series_rows > limits.max_series_rows)
     c.r.error("/output/series/interval",

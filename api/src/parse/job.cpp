@@ -79,6 +79,7 @@ ParseResult parse_text(std::string_view text, const Limits& limits) {
     ParsedJob job;
     job.name = c.name;
     job.cost = estimate_cost(c.p);
+    job.warnings = std::move(c.warnings);
     for (const ProblemIssue& w : problem_warnings(c.p))
       job.warnings.push_back({pointer_of_solver_location(w.where), w.message});
     job.problem = std::move(c.p);

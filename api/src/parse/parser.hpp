@@ -68,6 +68,9 @@ struct ParseContext {
   std::vector<std::string> traction_paths;
   bool any_pore_pressure_bc = false;
   std::string first_pore_pressure_bc;
+  /// Runnable but worth knowing (e.g. time.implicit with the explicit
+  /// scheme); parse_job puts them before the solver's warnings.
+  std::vector<SpecError> warnings;
 };
 
 // ------------------------------------------------------------- sections
@@ -122,6 +125,10 @@ void output_keys(std::vector<SpecObjectKeys>& out);
 Keys field_names();
 Keys traction_faces();
 Keys shape_function_names();
+/// time.scheme values (in hmpm::Scheme order) and time.implicit.linear_solver
+/// values (in hmpm::LinearSolver order).
+Keys scheme_names();
+Keys linear_solver_names();
 /// `location` with `keys` as one SpecObjectKeys entry.
 SpecObjectKeys keys_entry(std::string location, Keys keys);
 

@@ -30,6 +30,32 @@ JobCost cost_of(const hmpm::api::CostEstimate& c) {
                  .dt = c.dt};
 }
 
+// The cost document with the wall-time estimate of every scheme, from
+// this server's calibration (POST /validate and the 201 of POST /jobs).
+Json cost_with_estimate(const Context& c, const hmpm::api::ParsedJob& job) {
+  hmpm::api::Calibration calibration;
+  if (c.config.seconds_per_particle_step > 0) {
+    calibration.seconds_per_particle_step = c.config.seconds_per_particle_step;
+    calibration.measured = true;
+  }
+  calibration.threads = std::max(c.config.threads_per_job, 1);
+  const hmpm::api::CostEstimate cost = hmpm::api::estimate_cost(job.problem, calibration);
+  Json doc = cost_document(cost_of(cost));
+  doc["scheme"] = hmpm::scheme_name(cost.scheme);
+  doc["wall_seconds"] = cost.wall_seconds;
+  Json schemes = Json::array();
+  for (const hmpm::api::SchemeCost& s : cost.schemes)
+    schemes.push_back(Json{{"scheme", hmpm::scheme_name(s.scheme)},
+                           {"steps", s.steps},
+                           {"dt", s.dt},
+                           {"fixed_dt", s.fixed},
+                           {"wall_seconds", s.wall_seconds}});
+  doc["schemes"] = std::move(schemes);
+  doc["seconds_per_particle_step"] = calibration.seconds_per_particle_step;
+  doc["calibrated"] = calibration.measured;
+  return doc;
+}
+
 Json spec_issues(const std::vector<hmpm::api::SpecError>& issues) {
   Json out = Json::array();
   for (const auto& e : issues) {
@@ -124,6 +150,7 @@ void submit_job(Context& c, const httplib::Request& req, httplib::Response& res,
   // the run's summary.json repeats them.
   const auto accepted_document = [&] {
     Json doc = status_document(submitted.job);
+    doc["cost"] = cost_with_estimate(c, *parsed.job);
     if (!parsed.job->warnings.empty()) doc["warnings"] = spec_issues(parsed.job->warnings);
     return doc;
   };
@@ -220,7 +247,7 @@ void validate_spec(Context& c, const httplib::Request&, httplib::Response& res,
   send_json(res, 200,
             Json{{"valid", true},
                  {"warnings", spec_issues(parsed.job->warnings)},
-                 {"cost", cost_document(cost_of(parsed.job->cost))}});
+                 {"cost", cost_with_estimate(c, *parsed.job)}});
 }
 
 void get_job(Context& c, const httplib::Request& req, httplib::Response& res) {
@@ -231,6 +258,7 @@ void get_job(Context& c, const httplib::Request& req, httplib::Response& res) {
   // same bytes give the same warnings), so the store keeps no copy of them.
   const hmpm::api::ParseResult parsed = hmpm::api::parse_job(job->spec, c.limits);
   doc["warnings"] = parsed.job ? spec_issues(parsed.job->warnings) : Json::array();
+  if (parsed.job) doc["cost"] = cost_with_estimate(c, *parsed.job);
   send_json(res, 200, doc);
 }
 

@@ -44,6 +44,32 @@ struct Limits {
   std::int64_t max_series_particles = 10'000;  ///< entries of output.series.particles
 };
 
+/// The machine speed the wall-time estimate scales with (docs/performance.md,
+/// "Wall-time estimate"): the seconds one particle-step of the reference
+/// particle (2D, linear shape functions, elastic) takes on one thread.
+/// hmpm-server measures it at start-up (`calibrate`); without a measurement
+/// the default is the value measured on the development machine.
+struct Calibration {
+  double seconds_per_particle_step = 1.0e-7;
+  int threads = 1;        ///< solver threads a job runs with
+  bool measured = false;  ///< false: the built-in default
+};
+
+/// Runs a fixed small explicit problem (about 0.2 s) a few times and returns
+/// the median seconds per reference particle-step; `threads` is stored for
+/// the estimate (the problem itself is small enough to run on one).
+Calibration calibrate(int threads);
+
+/// Steps and expected wall time of one scheme for the same Problem.
+struct SchemeCost {
+  hmpm::Scheme scheme = hmpm::Scheme::explicit_scheme;
+  std::int64_t steps = 0;
+  double dt = 0.0;  ///< the (first) step, s
+  /// false when the step varies (quasi_static growth or automatic).
+  bool fixed = true;
+  double wall_seconds = 0.0;
+};
+
 /// What a job will cost, computed before it runs.
 struct CostEstimate {
   std::int64_t particles = 0;
@@ -56,6 +82,12 @@ struct CostEstimate {
   std::int64_t output_bytes = 0;  ///< result files estimate
   std::int64_t series_rows = 0;
   std::int64_t snapshots = 0;
+  hmpm::Scheme scheme = hmpm::Scheme::explicit_scheme;  ///< time.scheme
+  double wall_seconds = 0.0;  ///< expected wall time of the run with its scheme
+  Calibration calibration;    ///< what wall_seconds was computed with
+  /// Every scheme for the same problem (explicit, semi_implicit,
+  /// quasi_static), each with its automatic step except the run's own.
+  std::vector<SchemeCost> schemes;
 };
 
 struct ParsedJob {
@@ -92,7 +124,7 @@ JobOutcome run_job(const ParsedJob& job, const std::filesystem::path& out_dir,
 /// Cost of `problem` as `parse_job` computes it (particles, nodes, steps
 /// from the chosen dt, memory and output estimates). `problem` must have
 /// passed `hmpm::check_problem`.
-CostEstimate estimate_cost(const hmpm::Problem& problem);
+CostEstimate estimate_cost(const hmpm::Problem& problem, const Calibration& calibration = {});
 
 /// The keys `parse_job` accepts in each object of a spec. `location` is a
 /// JSON pointer pattern where "*" stands for any array index or material
