@@ -197,7 +197,8 @@ StepGrowth automatic_growth(const Problem& p) {
   const Scales s = scales(p);
   const double end = p.time.end;
   StepGrowth g;
-  g.initial = std::min(std::isfinite(s.consolidation) ? 1e-4 * s.consolidation : inf, end / 100);
+  g.initial = end / 100;
+  if (std::isfinite(s.consolidation)) g.initial = std::min(g.initial, 1e-4 * s.consolidation);
   g.max = std::max(end / 20, g.initial);
   g.growth = 1.25;
   return g;
