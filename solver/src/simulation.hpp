@@ -56,6 +56,7 @@ template <int Dim, class Shape>
 class ExplicitScheme;
 template <int Dim, class Shape>
 class SemiImplicitScheme;
+template <int Dim, class Shape>
 class QuasiStaticScheme;
 
 template <int Dim, class Shape>
