@@ -10,7 +10,7 @@
 #   --port P    port (default 8080; HMPM_PORT); 0 picks a free one
 #   --data DIR  where the database and result files live (default ./data)
 #   after --     anything hmpm-server accepts, e.g. -- --workers 2 --token s3cret
-#                (docs/api.md lists them)
+#                or -- --retain-days 7 (docs/api.md lists them)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 host=${HMPM_HOST:-127.0.0.1}

@@ -11,10 +11,12 @@
 // Routes, status codes and problem types are documented in docs/api.md.
 #pragma once
 
+#include <chrono>
 #include <cstddef>
 #include <filesystem>
 #include <memory>
 #include <string>
+#include <vector>
 
 namespace hmpm::server {
 
@@ -35,6 +37,10 @@ struct ServiceConfig {
   double progress_interval_s = 1.0;    ///< how often a running job's progress is stored
   double heartbeat_interval_s = 10.0;  ///< SSE comment line when nothing else was sent
   double lease_s = 30.0;  ///< a running job's claim lapses this long after its last renewal
+  /// Ended jobs (and their files) are purged this many days after they
+  /// ended, at start-up and hourly; 0 keeps them forever (retention.hpp).
+  int retain_days = 30;
+  double retention_interval_s = 3600.0;  ///< how often run() purges
 };
 
 class Service {
@@ -59,6 +65,10 @@ class Service {
   void stop();
   /// True once run() is accepting connections.
   bool is_running() const;
+  /// Purges the jobs that ended more than retain_days before `now`, with
+  /// their folders; returns their ids. run() calls it at start-up and every
+  /// retention_interval_s with the system clock; tests pass a later `now`.
+  std::vector<std::string> purge_expired(std::chrono::system_clock::time_point now);
 
   const ServiceConfig& config() const;
 
