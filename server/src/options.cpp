@@ -36,7 +36,7 @@ std::string usage() {
   return "usage: hmpm-server [--host H] [--port P] --db PATH [--workers N] [--data-dir DIR]\n"
          "                   [--threads-per-job N] [--token T] [--max-queue N]\n"
          "                   [--job-wall-time S] [--max-attempts N] [--max-body-bytes N]\n"
-         "                   [--max-event-streams N] [--http-threads N]\n"
+         "                   [--max-event-streams N] [--http-threads N] [--retain-days N]\n"
          "  --host H              address to listen on (default 127.0.0.1)\n"
          "  --port P              port; 0 picks a free one (default 8080)\n"
          "  --db PATH             SQLite database, created if missing (required)\n"
@@ -50,6 +50,9 @@ std::string usage() {
          "  --max-body-bytes N    request body limit, 413 beyond (default 16777216)\n"
          "  --max-event-streams N concurrent event streams, 503 beyond (default 8)\n"
          "  --http-threads N      connections served at once (default 24)\n"
+         "  --retain-days N       purge jobs that ended (successful, failed, dismissed) more than\n"
+         "                        N days ago, with their files, at start-up and hourly; queued\n"
+         "                        and running jobs are never purged; 0 keeps all (default 30)\n"
          "The first line on stdout is 'listening on http://HOST:PORT'. SIGTERM or SIGINT\n"
          "stops accepting, puts running jobs back in the queue and exits 0.\n";
 }
@@ -110,6 +113,8 @@ ParsedOptions parse_options(const std::vector<std::string>& args, const char* en
        integer(0, 1000, [&](long n) { config.max_event_streams = static_cast<int>(n); })},
       {"--http-threads",
        integer(2, 1024, [&](long n) { config.http_threads = static_cast<int>(n); })},
+      {"--retain-days",
+       integer(0, 100'000, [&](long n) { config.retain_days = static_cast<int>(n); })},
   };
 
   for (std::size_t i = 0; i < args.size(); ++i) {

@@ -6,6 +6,8 @@
 // process is one store instance (`instance_id`): its claims carry that id,
 // its heartbeat renews their leases. Requests are served by http/.
 #include <chrono>
+#include <condition_variable>
+#include <mutex>
 #include <thread>
 #include <utility>
 
@@ -16,6 +18,7 @@
 #include "job_log.hpp"
 #include "metrics.hpp"
 #include "process_lock.hpp"
+#include "retention.hpp"
 #include "worker_pool.hpp"
 
 namespace hmpm::server {
@@ -102,6 +105,29 @@ struct Service::Impl {
   int port = -1;
   std::atomic<bool> run_started{false};
   std::atomic<bool> run_finished{false};
+  // The retention thread: purges at start and every retention_interval_s
+  // until run() ends.
+  std::mutex retention_mutex;
+  std::condition_variable retention_wake;
+  bool retention_stop = false;
+
+  void purge_now(std::chrono::system_clock::time_point now) {
+    try {
+      hmpm::server::purge_expired(*store, config.data_dir, config.retain_days, now);
+    } catch (const std::exception& e) {  // a failing database: try again next time
+      log_line({{"event", "store_error"}, {"during", "purge"}, {"detail", e.what()}});
+    }
+  }
+  void retention_loop() {
+    std::unique_lock<std::mutex> lock(retention_mutex);
+    while (!retention_stop) {
+      lock.unlock();
+      purge_now(std::chrono::system_clock::now());
+      lock.lock();
+      retention_wake.wait_for(lock, std::chrono::duration<double>(config.retention_interval_s),
+                              [&] { return retention_stop; });
+    }
+  }
 };
 
 Service::Service(ServiceConfig config) : impl_(std::make_unique<Impl>(std::move(config))) {}
@@ -136,8 +162,19 @@ bool Service::run() {
             {"db", s.config.db_path.string()},
             {"data_dir", s.config.data_dir.string()},
             {"instance", s.instance_id},
-            {"auth", !s.config.token.empty()}});
+            {"auth", !s.config.token.empty()},
+            {"retain_days", s.config.retain_days}});
+  std::thread retention;
+  if (s.config.retain_days > 0) retention = std::thread([&s] { s.retention_loop(); });
   const bool ok = s.stopping || s.server.listen_after_bind();
+  if (retention.joinable()) {
+    {
+      std::lock_guard<std::mutex> lock(s.retention_mutex);
+      s.retention_stop = true;
+    }
+    s.retention_wake.notify_all();
+    retention.join();
+  }
   s.workers.shutdown();  // running jobs go back to the queue
   s.run_finished = true;
   log_line({{"event", "stop"}});
@@ -154,6 +191,11 @@ void Service::stop() {
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
   }
   s.server.stop();
+}
+
+std::vector<std::string> Service::purge_expired(std::chrono::system_clock::time_point now) {
+  return hmpm::server::purge_expired(*impl_->store, impl_->config.data_dir,
+                                     impl_->config.retain_days, now);
 }
 
 bool Service::is_running() const {

@@ -22,8 +22,16 @@ void StoreContract::TearDown() {
 }
 
 JobStore& StoreContract::store() {
-  if (!store_) store_ = GetParam().open(scratch_);
+  if (!store_) store_ = GetParam().open(scratch_, [this] { return now(); });
   return *store_;
+}
+
+std::chrono::system_clock::time_point StoreContract::now() const {
+  return std::chrono::system_clock::now() + offset_;
+}
+
+void StoreContract::advance(std::chrono::system_clock::duration by) {
+  offset_ += by;
 }
 
 void StoreContract::close() {
@@ -316,6 +324,72 @@ TEST_P(StoreContract, EveryStatusOfTheTableIsStoredAndCounted) {
     ASSERT_EQ(listed.size(), 1u) << row.name;
     EXPECT_EQ(listed[0].name, row.name);
   }
+}
+
+TEST_P(StoreContract, PurgeForgetsOnlyJobsThatEndedBeforeTheCutoff) {
+  using std::chrono::hours;
+  const std::vector<ResultFile> files{
+      {"summary.json", 10, std::string(64, 'a'), "application/json"}};
+  // Ten days ago: one job of each ended kind, plus one still queued and one
+  // still running (never purged, however old).
+  const auto finished_old = store().submit(job("old-ok", "done-key", "h1"), 100).job.id;
+  const auto c_ok = claim_of(*store().claim_next(live()));
+  store().finish(c_ok, JobEnd{JobStatus::successful, "finished", "", files, 1});
+  const auto failed_old = store().submit(job("old-failed"), 100).job.id;
+  const auto c_bad = claim_of(*store().claim_next(live()));
+  store().finish(c_bad, JobEnd{JobStatus::failed, "boom", "boom", {}, 1});
+  const auto cancelled_old = store().submit(job("old-cancelled"), 100).job.id;
+  store().cancel(cancelled_old);
+  const auto deleted_old = store().submit(job("old-deleted"), 100).job.id;
+  store().dismiss(deleted_old);
+  const auto running_old = store().submit(job("old-running"), 100).job.id;
+  const auto c_run = claim_of(*store().claim_next(live()));
+  ASSERT_EQ(c_run.job_id, running_old);
+  const auto queued_old = store().submit(job("old-queued"), 100).job.id;
+  advance(hours(24 * 10));
+  // Today: ended jobs that are recent.
+  const auto finished_new = store().submit(job("new-ok"), 100).job.id;
+  const auto c_queued = claim_of(*store().claim_next(live()));  // FIFO: the old queued job
+  const auto c_new = claim_of(*store().claim_next(live()));
+  ASSERT_EQ(c_new.job_id, finished_new);
+  ASSERT_EQ(store().requeue(c_queued), ClaimState::held);  // back in the queue
+  store().finish(c_new, JobEnd{JobStatus::successful, "finished", "", files, 1});
+  const auto cancelled_new = store().submit(job("new-cancelled"), 100).job.id;
+  store().cancel(cancelled_new);
+  const auto queued_new = store().submit(job("new-queued"), 100).job.id;
+
+  // A cutoff five days back takes exactly the four old ended jobs.
+  const auto purged = store().purge_ended(now() - hours(24 * 5));
+  EXPECT_EQ(purged,
+            (std::vector<std::string>{finished_old, failed_old, cancelled_old, deleted_old}));
+  for (const auto& id : purged) {
+    EXPECT_FALSE(store().find(id)) << id;
+    EXPECT_TRUE(store().results(id).empty()) << id;
+    EXPECT_TRUE(store().ids_with_prefix(id, 5).empty()) << id;
+  }
+  for (const auto& id : {running_old, queued_old, finished_new, cancelled_new, queued_new}) {
+    EXPECT_TRUE(store().find(id)) << id;
+  }
+  EXPECT_EQ(store().results(finished_new).size(), 1u);
+  EXPECT_TRUE(store().purge_ended(now() - hours(24 * 5)).empty()) << "a second purge finds nothing";
+
+  // A cutoff in the future takes every ended job but never a queued or
+  // running one; the old running job still finishes under its claim.
+  const auto later = store().purge_ended(now() + hours(1));
+  EXPECT_EQ(later, (std::vector<std::string>{finished_new, cancelled_new}));
+  EXPECT_EQ(store().find(running_old)->status, JobStatus::running);
+  EXPECT_EQ(store().find(queued_old)->status, JobStatus::accepted);
+  EXPECT_EQ(store().find(queued_new)->status, JobStatus::accepted);
+  EXPECT_EQ(store().finish(c_run, JobEnd{JobStatus::successful, "finished", "", {}, 1}),
+            ClaimState::held);
+  // The purge survives a reopen, and the counts agree.
+  close();
+  EXPECT_FALSE(store().find(finished_old));
+  const auto counts = store().count_by_status();
+  EXPECT_EQ(counts.count(JobStatus::failed) ? counts.at(JobStatus::failed) : 0, 0);
+  EXPECT_EQ(store().list({}, "", 100).size(), 3u);
+  // A purged job's idempotency key is free again: the same key makes a new job.
+  EXPECT_EQ(store().submit(job("again", "done-key", "h2"), 100).outcome, SubmitOutcome::created);
 }
 
 TEST_P(StoreContract, ConcurrentWritersNeverFail) {

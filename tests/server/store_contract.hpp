@@ -3,7 +3,8 @@
 // The tests in store_contract.cpp are value-parameterised over a
 // `StoreBackend`: a name and a function that opens the backend's store on a
 // fresh scratch location (a folder for SQLite; a PostgreSQL backend would
-// derive a database from it). A backend runs the suite with one line:
+// derive a database from it) with the test's clock (`advance` ages jobs
+// without sleeping). A backend runs the suite with one line:
 //   INSTANTIATE_TEST_SUITE_P(Sqlite, StoreContract, ::testing::Values(StoreBackend{...}));
 // Everything here goes through the JobStore interface only: what a store
 // must do, not how. Backend details (files, migrations, locks) have their own
@@ -12,6 +13,7 @@
 
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <filesystem>
 #include <memory>
 #include <ostream>
@@ -23,8 +25,9 @@ namespace hmpm::server::testing {
 
 struct StoreBackend {
   std::string name;
-  /// Opens the store kept at `scratch` (the same location each call).
-  std::unique_ptr<JobStore> (*open)(const std::filesystem::path& scratch);
+  /// Opens the store kept at `scratch` (the same location each call),
+  /// reading the time from `clock`.
+  std::unique_ptr<JobStore> (*open)(const std::filesystem::path& scratch, WallClock clock);
 };
 
 /// Prints the backend's name in failure messages.
@@ -47,6 +50,10 @@ class StoreContract : public ::testing::TestWithParam<StoreBackend> {
   JobStore& store();
   /// Closes the store (as a stopping process does); the next store() reopens it.
   void close();
+  /// The store's clock: the system clock plus what advance() added.
+  std::chrono::system_clock::time_point now() const;
+  /// Moves the store's clock forward by `by`.
+  void advance(std::chrono::system_clock::duration by);
 
   /// A new job named `name`, with a unique id.
   static NewJob job(const std::string& name, const std::string& key = "",
@@ -58,6 +65,7 @@ class StoreContract : public ::testing::TestWithParam<StoreBackend> {
   static Claimant dead(const std::string& instance = "dead-instance");
 
   std::filesystem::path scratch_;
+  std::chrono::system_clock::duration offset_{0};
   std::unique_ptr<JobStore> store_;
 };
 

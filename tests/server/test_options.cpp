@@ -16,6 +16,20 @@ TEST(Options, DefaultsNeedOnlyTheDatabase) {
   EXPECT_EQ(parsed.config->max_attempts, 3);
   EXPECT_TRUE(parsed.config->token.empty());
   EXPECT_TRUE(parsed.config->data_dir.empty());  // resolved to <db dir>/results by the service
+  EXPECT_EQ(parsed.config->retain_days, 30);
+}
+
+TEST(Options, RetainDaysZeroKeepsForeverAndNegativeIsRefused) {
+  const auto kept = parse_options({"--db", "d", "--retain-days", "0"}, nullptr);
+  ASSERT_TRUE(kept.config) << kept.error;
+  EXPECT_EQ(kept.config->retain_days, 0);
+  const auto week = parse_options({"--db", "d", "--retain-days=7"}, nullptr);
+  ASSERT_TRUE(week.config) << week.error;
+  EXPECT_EQ(week.config->retain_days, 7);
+  EXPECT_NE(
+      parse_options({"--db", "d", "--retain-days", "-1"}, nullptr).error.find("--retain-days"),
+      std::string::npos);
+  EXPECT_NE(usage().find("--retain-days N"), std::string::npos);
 }
 
 TEST(Options, EveryFlagIsRead) {

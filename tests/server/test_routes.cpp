@@ -637,6 +637,52 @@ TEST_F(RoutesTest, CancellingAFinishedJobIs409AndChangesNothing) {
                  "not-found");
 }
 
+TEST_F(RoutesTest, RetentionPurgesOldEndedJobsWithTheirFilesAndTheyAre404) {
+  using std::chrono::hours;
+  start();
+  const std::string done = submit(small_spec("old-done"));
+  ASSERT_EQ(wait_final(done).value("status", ""), "successful");
+  const std::string running = submit_running("still-running");
+  const std::filesystem::path data = service_->config().data_dir;
+  ASSERT_TRUE(std::filesystem::exists(data / done / "summary.json"));
+  // A folder a crash left behind (no job), and one that is not a job's.
+  const std::string orphan = "0123abcd-0000-4000-8000-000000000000";
+  std::filesystem::create_directories(data / orphan);
+  std::filesystem::create_directories(data / "not-a-job");
+  const auto now = std::chrono::system_clock::now();
+
+  // The default keeps ended jobs 30 days: 29 days on, nothing goes.
+  EXPECT_TRUE(service_->purge_expired(now + hours(24 * 29)).empty());
+  EXPECT_EQ(client_->Get(("/jobs/" + done).c_str())->status, 200);
+  EXPECT_TRUE(std::filesystem::exists(data / done));
+
+  // 31 days on: the finished job and its folder go; the running one stays.
+  EXPECT_EQ(service_->purge_expired(now + hours(24 * 31)), std::vector<std::string>{done});
+  expect_problem(client_->Get(("/jobs/" + done).c_str()), 404, "not-found");
+  expect_problem(client_->Get(("/jobs/" + done + "/results").c_str()), 404, "not-found");
+  EXPECT_FALSE(std::filesystem::exists(data / done));
+  EXPECT_FALSE(std::filesystem::exists(data / orphan));
+  EXPECT_TRUE(std::filesystem::exists(data / "not-a-job"));
+  EXPECT_EQ(json_of(client_->Get(("/jobs/" + running).c_str())->body)["status"], "running");
+  EXPECT_TRUE(std::filesystem::exists(data / running));
+  const Json list = json_of(client_->Get("/jobs")->body);
+  ASSERT_TRUE(list.contains("jobs")) << list.dump();
+  ASSERT_EQ(list["jobs"].size(), 1u);
+  EXPECT_EQ(list["jobs"][0]["jobID"], running);
+}
+
+TEST_F(RoutesTest, RetainDaysZeroKeepsEndedJobsForever) {
+  ServiceConfig c = config();
+  c.retain_days = 0;
+  start(c);
+  const std::string done = submit(small_spec("kept"));
+  ASSERT_EQ(wait_final(done).value("status", ""), "successful");
+  EXPECT_TRUE(
+      service_->purge_expired(std::chrono::system_clock::now() + std::chrono::hours(24 * 3650))
+          .empty());
+  EXPECT_EQ(client_->Get(("/jobs/" + done + "/results/summary.json").c_str())->status, 200);
+}
+
 TEST_F(RoutesTest, TheJobLogIsTextReadableWhileItRunsAndEndsWithTheOutcome) {
   start();
   const std::string id = submit_running("logged");

@@ -14,8 +14,8 @@
 namespace hmpm::server::testing {
 namespace {
 
-std::unique_ptr<JobStore> open_in(const std::filesystem::path& scratch) {
-  return open_sqlite_store(scratch / "jobs.sqlite");
+std::unique_ptr<JobStore> open_in(const std::filesystem::path& scratch, WallClock clock) {
+  return open_sqlite_store(scratch / "jobs.sqlite", std::move(clock));
 }
 
 INSTANTIATE_TEST_SUITE_P(Sqlite, StoreContract, ::testing::Values(StoreBackend{"sqlite", open_in}),

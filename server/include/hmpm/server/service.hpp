@@ -11,10 +11,12 @@
 // Routes, status codes and problem types are documented in docs/api.md.
 #pragma once
 
+#include <chrono>
 #include <cstddef>
 #include <filesystem>
 #include <memory>
 #include <string>
+#include <vector>
 
 namespace hmpm::server {
 
@@ -38,6 +40,10 @@ struct ServiceConfig {
   /// Calibration of the wall-time estimate (hmpm::api::calibrate, which
   /// hmpm-server runs at start-up); <= 0: the api's built-in default.
   double seconds_per_particle_step = 0.0;
+  /// Ended jobs (and their files) are purged this many days after they
+  /// ended, at start-up and hourly; 0 keeps them forever (retention.hpp).
+  int retain_days = 30;
+  double retention_interval_s = 3600.0;  ///< how often run() purges
 };
 
 class Service {
@@ -62,6 +68,10 @@ class Service {
   void stop();
   /// True once run() is accepting connections.
   bool is_running() const;
+  /// Purges the jobs that ended more than retain_days before `now`, with
+  /// their folders; returns their ids. run() calls it at start-up and every
+  /// retention_interval_s with the system clock; tests pass a later `now`.
+  std::vector<std::string> purge_expired(std::chrono::system_clock::time_point now);
 
   const ServiceConfig& config() const;
 

@@ -22,8 +22,10 @@
 // turns into a 500 and start-up into exit 1.
 #pragma once
 
+#include <chrono>
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <map>
 #include <memory>
 #include <optional>
@@ -35,6 +37,11 @@
 #include "hmpm/server/job_status.hpp"
 
 namespace hmpm::server {
+
+/// Where a store reads the wall clock: timestamps, leases, the retention
+/// cutoff. Empty means std::chrono::system_clock::now; tests pass their own
+/// to age jobs without sleeping.
+using WallClock = std::function<std::chrono::system_clock::time_point()>;
 
 /// A database failure the service cannot recover from by itself.
 class StoreFailure : public std::runtime_error {
@@ -220,6 +227,14 @@ class JobStore {
   virtual RecoveryReport recover(int max_attempts) = 0;
 
   virtual StatusCounts count_by_status() = 0;
+
+  /// Retention: forgets every ended job (successful, failed, dismissed)
+  /// whose end (`finished`) is before `ended_before`, with its result-file
+  /// rows and idempotency key, and returns the ids in submission order; the
+  /// caller removes their folders. Accepted and running jobs are never
+  /// purged, however old. A purged id is unknown from then on (find: nullopt).
+  virtual std::vector<std::string> purge_ended(
+      std::chrono::system_clock::time_point ended_before) = 0;
 };
 
 /// Opens (creating if needed) the SQLite database at `db_path` for this
@@ -228,6 +243,8 @@ class JobStore {
 /// knows, or another live process holds it (the message names its pid).
 /// Holding the file proves that no other process runs any job, so the leases
 /// of earlier processes end on open and recover() requeues their jobs.
-std::unique_ptr<JobStore> open_sqlite_store(const std::filesystem::path& db_path);
+/// `clock` is the store's time (empty: the system clock).
+std::unique_ptr<JobStore> open_sqlite_store(const std::filesystem::path& db_path,
+                                            WallClock clock = {});
 
 }  // namespace hmpm::server

@@ -20,16 +20,6 @@ std::string sql_name(JobStatus status) {
   return std::string("'") + status_name(status) + "'";
 }
 
-std::int64_t now_ms() {
-  return std::chrono::duration_cast<std::chrono::milliseconds>(
-             std::chrono::system_clock::now().time_since_epoch())
-      .count();
-}
-
-std::int64_t lease_until(const Claimant& who) {
-  return now_ms() + static_cast<std::int64_t>(who.lease_s * 1000.0);
-}
-
 constexpr const char* job_columns =
     "id, seq, name, spec, status, progress, message, created, started, finished, updated, "
     "attempts, failure_reason, cost_particles, cost_nodes, cost_cells, cost_steps, "
@@ -110,8 +100,25 @@ std::filesystem::path lock_path_for(const std::filesystem::path& db_path) {
   return db_path.string() + ".lock";
 }
 
-SqliteStore::SqliteStore(const std::filesystem::path& db_path)
-    : lock_(ProcessLock::hold(lock_path_for(db_path), "database " + db_path.string())),
+std::chrono::system_clock::time_point SqliteStore::now() const {
+  return clock_ ? clock_() : std::chrono::system_clock::now();
+}
+
+std::string SqliteStore::now_text() const {
+  return format_rfc3339(now());
+}
+
+std::int64_t SqliteStore::now_ms() const {
+  return std::chrono::duration_cast<std::chrono::milliseconds>(now().time_since_epoch()).count();
+}
+
+std::int64_t SqliteStore::lease_until(const Claimant& who) const {
+  return now_ms() + static_cast<std::int64_t>(who.lease_s * 1000.0);
+}
+
+SqliteStore::SqliteStore(const std::filesystem::path& db_path, WallClock clock)
+    : clock_(std::move(clock)),
+      lock_(ProcessLock::hold(lock_path_for(db_path), "database " + db_path.string())),
       pool_(db_path) {
   auto connection = pool_.lease();
   sqlite3* db = connection.get();
@@ -149,7 +156,7 @@ SubmitResult SqliteStore::submit(const NewJob& job, std::int64_t max_queue) {
     Statement s(db, "SELECT count(*) FROM jobs WHERE status = " + sql_name(JobStatus::accepted));
     if (s.step() && s.integer(0) >= max_queue) return {SubmitOutcome::queue_full, {}};
   }
-  const std::string now = now_rfc3339();
+  const std::string now = now_text();
   Statement s(
       db,
       "INSERT INTO jobs (id, name, spec, status, message, created, updated, idempotency_key, "
@@ -216,7 +223,7 @@ std::optional<JobRecord> SqliteStore::claim_next(const Claimant& who) {
     if (!s.step()) return std::nullopt;
     id = s.text(0);
   }
-  const std::string now = now_rfc3339();
+  const std::string now = now_text();
   Statement s(db, "UPDATE jobs SET status = " + sql_name(JobStatus::running) +
                       ", progress = 0, message = 'running', started = ?1, finished = NULL, "
                       "updated = ?1, attempts = attempts + 1, owner = ?3, "
@@ -247,7 +254,7 @@ ClaimState SqliteStore::update_progress(const Claim& claim, double percent) {
   WriteTransaction tx(db);
   Statement s(db, "UPDATE jobs SET progress = ?4, updated = ?5 WHERE " + claim_held);
   bind_claim(s, claim);
-  s.bind(4, percent).bind(5, now_rfc3339());
+  s.bind(4, percent).bind(5, now_text());
   s.step();
   const ClaimState state = sqlite3_changes(db) == 1 ? ClaimState::held : claim_state(db, claim);
   tx.commit();
@@ -258,7 +265,7 @@ ClaimState SqliteStore::finish(const Claim& claim, const JobEnd& end) {
   auto connection = pool_.lease();
   sqlite3* db = connection.get();
   WriteTransaction tx(db);
-  const std::string now = now_rfc3339();
+  const std::string now = now_text();
   {
     Statement s(db,
                 "UPDATE jobs SET status = ?4, message = ?5, failure_reason = ?6, finished = ?7, "
@@ -287,7 +294,7 @@ ClaimState SqliteStore::requeue(const Claim& claim) {
                       "attempts = max(attempts - 1, 0), lease_expires_ms = 0 WHERE " +
                       claim_held);
   bind_claim(s, claim);
-  s.bind(4, now_rfc3339());
+  s.bind(4, now_text());
   s.step();
   const ClaimState state = sqlite3_changes(db) == 1 ? ClaimState::held : claim_state(db, claim);
   tx.commit();
@@ -303,7 +310,7 @@ std::optional<JobRecord> SqliteStore::cancel(const std::string& id) {
   Statement s(db, "UPDATE jobs SET status = " + sql_name(JobStatus::dismissed) +
                       ", message = 'cancelled by the client', finished = ?1, updated = ?1 "
                       "WHERE id = ?2");
-  s.bind(1, now_rfc3339()).bind(2, id);
+  s.bind(1, now_text()).bind(2, id);
   s.step();
   tx.commit();
   return before;
@@ -320,7 +327,7 @@ std::optional<JobRecord> SqliteStore::dismiss(const std::string& id) {
     Statement s(db, "UPDATE jobs SET status = " + sql_name(JobStatus::dismissed) +
                         ", message = ?3, results_deleted = 1, "
                         "finished = coalesce(finished, ?1), updated = ?1 WHERE id = ?2");
-    s.bind(1, now_rfc3339()).bind(2, id);
+    s.bind(1, now_text()).bind(2, id);
     s.bind(3, was_dismissed ? before->message + "; results deleted" : "dismissed by the client");
     s.step();
   }
@@ -342,7 +349,7 @@ ClaimState SqliteStore::keep_results(const Claim& claim, const std::vector<Resul
   if (job->results_deleted) return ClaimState::dismissed;
   {
     Statement s(db, "UPDATE jobs SET run_seconds = ?2, updated = ?3 WHERE id = ?1");
-    s.bind(1, claim.job_id).bind(2, run_seconds).bind(3, now_rfc3339());
+    s.bind(1, claim.job_id).bind(2, run_seconds).bind(3, now_text());
     s.step();
   }
   clear_results(db, claim.job_id);
@@ -373,7 +380,7 @@ RecoveryReport SqliteStore::recover(int max_attempts) {
     while (s.step()) lapsed.emplace_back(s.text(0), static_cast<int>(s.integer(1)));
   }
   RecoveryReport report;
-  const std::string now = now_rfc3339();
+  const std::string now = now_text();
   for (const auto& [id, attempts] : lapsed) {
     if (attempts < max_attempts) {
       Statement s(db,
@@ -409,12 +416,37 @@ StatusCounts SqliteStore::count_by_status() {
   return counts;
 }
 
+std::vector<std::string> SqliteStore::purge_ended(
+    std::chrono::system_clock::time_point ended_before) {
+  auto connection = pool_.lease();
+  sqlite3* db = connection.get();
+  WriteTransaction tx(db);
+  // RFC 3339 with fixed-width milliseconds sorts as text, so the cutoff is a
+  // string comparison (and the status index narrows the scan).
+  const std::string ended = "status IN (" + sql_name(JobStatus::successful) + "," +
+                            sql_name(JobStatus::failed) + "," + sql_name(JobStatus::dismissed) +
+                            ") AND finished IS NOT NULL AND finished < ?1";
+  const std::string cutoff = format_rfc3339(ended_before);
+  std::vector<std::string> ids;
+  {
+    Statement s(db, "SELECT id FROM jobs WHERE " + ended + " ORDER BY seq");
+    s.bind(1, cutoff);
+    while (s.step()) ids.push_back(s.text(0));
+  }
+  for (const std::string& id : ids) clear_results(db, id);
+  Statement s(db, "DELETE FROM jobs WHERE " + ended);
+  s.bind(1, cutoff);
+  s.step();
+  tx.commit();
+  return ids;
+}
+
 }  // namespace hmpm::server::sqlite
 
 namespace hmpm::server {
 
-std::unique_ptr<JobStore> open_sqlite_store(const std::filesystem::path& db_path) {
-  return std::make_unique<sqlite::SqliteStore>(db_path);
+std::unique_ptr<JobStore> open_sqlite_store(const std::filesystem::path& db_path, WallClock clock) {
+  return std::make_unique<sqlite::SqliteStore>(db_path, std::move(clock));
 }
 
 }  // namespace hmpm::server

@@ -20,7 +20,7 @@ namespace hmpm::server::sqlite {
 class SqliteStore final : public JobStore {
  public:
   /// See open_sqlite_store in store.hpp.
-  explicit SqliteStore(const std::filesystem::path& db_path);
+  SqliteStore(const std::filesystem::path& db_path, WallClock clock);
 
   void probe() override;
   SubmitResult submit(const NewJob& job, std::int64_t max_queue) override;
@@ -40,8 +40,15 @@ class SqliteStore final : public JobStore {
   std::vector<ResultFile> results(const std::string& id) override;
   RecoveryReport recover(int max_attempts) override;
   StatusCounts count_by_status() override;
+  std::vector<std::string> purge_ended(std::chrono::system_clock::time_point ended_before) override;
 
  private:
+  std::chrono::system_clock::time_point now() const;
+  std::string now_text() const;  ///< now() as RFC 3339
+  std::int64_t now_ms() const;   ///< now() as Unix ms
+  std::int64_t lease_until(const Claimant& who) const;
+
+  WallClock clock_;
   ProcessLock lock_;  ///< taken first, released last
   ConnectionPool pool_;
 };
