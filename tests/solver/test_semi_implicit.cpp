@@ -370,6 +370,26 @@ TEST(SemiImplicit, StableWhenDarcyDominates) {
   EXPECT_LT(e, 1e-3);
 }
 
+// A run whose state becomes non-finite fails at that step with a message
+// saying what to change (here a load that turns NaN at t = 0.01 s: the
+// predicted velocity, hence the pressure system's right-hand side, is
+// non-finite, and the step reports it before solving or moving anything).
+TEST(SemiImplicit, NonFiniteStateFailsWithWhatToChange) {
+  Column c;
+  c.cells = 20;
+  hmpm::Problem p = terzaghi(c, 0.02);
+  const double q = c.q;
+  p.tractions[0].traction[c.axis] = [q](double t) {
+    return t > 0.01 ? std::numeric_limits<double>::quiet_NaN() : -q;
+  };
+  const hmpm::RunResult r = hmpm::run(p);
+  ASSERT_EQ(r.status, hmpm::RunStatus::failed);
+  EXPECT_NE(r.message.find("became non-finite: the run diverged"), std::string::npos) << r.message;
+  EXPECT_NE(r.message.find("What to change: reduce time.dt or time.courant"), std::string::npos)
+      << r.message;
+  std::printf("%s\n", r.message.c_str());
+}
+
 // Not a test: direct against iterative solves on larger grids (docs/schemes.md).
 // Run with --gtest_also_run_disabled_tests --gtest_filter='*Benchmark*'.
 TEST(SemiImplicit, DISABLED_BenchmarkLinearSolvers) {

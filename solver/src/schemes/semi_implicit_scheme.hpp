@@ -189,6 +189,11 @@ class SemiImplicitScheme final : public TimeScheme {
           last_dp_[static_cast<std::size_t>(node_of_[static_cast<std::size_t>(c)])];
     Eigen::Map<const Eigen::VectorXd> b(rhs_.data(), n);
     Eigen::Map<Eigen::VectorXd> x(x_.data(), n);
+    if (!b.allFinite()) {
+      sim_.fail_run("the predicted velocity or fluid flux became non-finite: the run diverged",
+                    failure_hint(true));
+      return false;
+    }
     const ImplicitControl& control = sim_.problem_.time.implicit;
     const PressureSystem::Outcome r =
         system_.solve(b, x, control.linear_solver, control.linear_tolerance, Dim);
@@ -206,11 +211,7 @@ class SemiImplicitScheme final : public TimeScheme {
         what += " iterations";
       }
       what += ")";
-      std::string hint = "reduce time.dt or time.courant (the stable step estimate is ";
-      hint += Sim::number(sim_.stable_.limit);
-      hint += " s), check moduli, densities and permeabilities for unrealistic values";
-      if (!r.direct) hint += ", or ask for the direct linear solver";
-      sim_.fail_run(std::move(what), std::move(hint));
+      sim_.fail_run(std::move(what), failure_hint(r.direct));
       return false;
     }
     for (int c = 0; c < n; ++c) {
@@ -219,6 +220,16 @@ class SemiImplicitScheme final : public TimeScheme {
       last_dp_[i] = grid.dp[i];
     }
     return true;
+  }
+
+  /// What to change when the pressure step fails (direct: no advice on
+  /// the linear solver).
+  std::string failure_hint(bool direct) const {
+    std::string hint = "reduce time.dt or time.courant (the stable step estimate is ";
+    hint += Sim::number(sim_.stable_.limit);
+    hint += " s), and check moduli, densities, permeabilities and loads for unrealistic values";
+    if (!direct) hint += ", or ask for the direct linear solver";
+    return hint;
   }
 
   /// v^{n+1} = v* + dt f_dp/m, a^{n+1} = a* + f_dp/m, then the velocity
