@@ -14,7 +14,7 @@ void PressureSystem::begin(int n, std::int64_t max_entries) {
   a_.outerIndexPtr()[0] = 0;
 }
 
-PressureSystem::Outcome PressureSystem::solve(Eigen::Ref<const Eigen::VectorXd> b,
+PressureSystem::Outcome PressureSystem::solve(const Eigen::Ref<const Eigen::VectorXd>& b,
                                               Eigen::Ref<Eigen::VectorXd> x, LinearSolver choice,
                                               double tolerance, int dim) {
   a_.resizeNonZeros(static_cast<Eigen::Index>(entries_));

@@ -50,7 +50,7 @@ class PressureSystem {
 
   /// Solves A x = b (x: the initial guess of the iterative solver on entry).
   /// `dim` picks the automatic solver's size limit.
-  Outcome solve(Eigen::Ref<const Eigen::VectorXd> b, Eigen::Ref<Eigen::VectorXd> x,
+  Outcome solve(const Eigen::Ref<const Eigen::VectorXd>& b, Eigen::Ref<Eigen::VectorXd> x,
                 LinearSolver choice, double tolerance, int dim);
 
   int size() const { return static_cast<int>(a_.rows()); }

@@ -53,7 +53,8 @@ struct CouplingBox {
 
 /// Predictor flux (saturated particles): the explicit scheme's mass-balance
 /// right-hand side, V (grad N_i . w* - N_i div v*), with the predicted
-/// Lagrangian nodal velocity v* and acceleration a* of update_nodal_momentum
+/// re-mapped nodal velocity v* (nodal remap, map_predicted_velocity) and
+/// the acceleration a* of update_nodal_momentum
 /// and w* = -k/gw (grad p^n - rho_f b + rho_f a*), scattered to nodal flux.
 template <int Dim, class Shape>
 inline void Simulation<Dim, Shape>::map_predicted_fluid_flux(const Out& out, std::size_t begin,
@@ -68,7 +69,7 @@ inline void Simulation<Dim, Shape>::map_predicted_fluid_flux(const Out& out, std
     Vec grad_p = Vec::Zero(), a = Vec::Zero();
     for (int k = 0; k < StencilT::N; ++k) {
       const std::int64_t i = s.node[k];
-      div_v += s.grad(k).dot(grid_.velocity[i]);
+      div_v += s.grad(k).dot(grid_.remap[i]);
       grad_p += grid_.pressure[i] * s.grad(k);
       a += s.w[k] * grid_.accel[i];
     }
@@ -77,6 +78,21 @@ inline void Simulation<Dim, Shape>::map_predicted_fluid_flux(const Out& out, std
     const double vol = particles_.volume[p];
     for (int k = 0; k < StencilT::N; ++k)
       flux_out[s.node[k]] += vol * (s.grad(k).dot(w) - s.w[k] * div_v);
+  }
+}
+
+/// The predicted particle velocities v_p + dt sum N a* re-mapped to the
+/// nodes (MUSL, as the strain will see them), scattered to nodal remap.
+template <int Dim, class Shape>
+inline void Simulation<Dim, Shape>::map_predicted_velocity(const Out& out, std::size_t begin,
+                                                           std::size_t end, double dt) {
+  StencilT s;
+  for (std::size_t p = begin; p < end; ++p) {
+    stencil_in_step<false, true>(p, s);
+    Vec a = Vec::Zero();
+    for (int k = 0; k < StencilT::N; ++k) a += s.w[k] * grid_.accel[s.node[k]];
+    const Vec mv = particles_.mass[p] * (particles_.v[p] + dt * a);
+    for (int k = 0; k < StencilT::N; ++k) at<nodal::remap>(out)[s.node[k]] += s.w[k] * mv;
   }
 }
 
