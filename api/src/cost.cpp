@@ -182,28 +182,6 @@ Scales scales(const Problem& p) {
   return s;
 }
 
-/// The semi-implicit limit h / (c_s sqrt(d)), c_s the skeleton's wave speed
-/// with the mixture's inertia (Courant factor 1).
-double skeleton_limit(const Problem& p) {
-  const Scales s = scales(p);
-  if (!(s.skeleton_speed > 0)) return inf;
-  return s.h / (s.skeleton_speed * std::sqrt(std::clamp(p.dimension, 1, 3)));
-}
-
-/// The quasi-static step growth the estimate (and the advice) assumes when
-/// the spec gives none: from T_v = 1e-4 of the fastest consolidation (or
-/// end/100 when dry) up to end/20, growing by 1.25.
-StepGrowth automatic_growth(const Problem& p) {
-  const Scales s = scales(p);
-  const double end = p.time.end;
-  StepGrowth g;
-  g.initial = end / 100;
-  if (std::isfinite(s.consolidation)) g.initial = std::min(g.initial, 1e-4 * s.consolidation);
-  g.max = std::max(end / 20, g.initial);
-  g.growth = 1.25;
-  return g;
-}
-
 std::string fmt(double v) {
   return format_significant(v, 3);
 }
@@ -235,27 +213,9 @@ SchemeCost scheme_cost(const Problem& problem, Scheme scheme, const Calibration&
   SchemeCost c;
   c.scheme = scheme;
   const StableStep s = stable_step(p);
-  double steps = static_cast<double>(s.steps);
+  const double steps = static_cast<double>(s.steps);
   c.dt = s.chosen;
   c.fixed = s.fixed;
-  if (!own) {
-    // Until the solver has a scheme's rule, its StableStep is the explicit
-    // one: estimate the scheme's own limit instead.
-    Problem e = p;
-    e.time.scheme = Scheme::explicit_scheme;
-    const StableStep explicit_step = stable_step(e);
-    const bool solver_knows = scheme == Scheme::explicit_scheme || s.limit != explicit_step.limit ||
-                              s.fixed != explicit_step.fixed;
-    if (!solver_knows && scheme == Scheme::semi_implicit) {
-      c.dt = p.time.courant * skeleton_limit(p);
-      steps = std::ceil(p.time.end / c.dt - 1e-9);
-    } else if (!solver_knows && scheme == Scheme::quasi_static) {
-      const StepGrowth g = automatic_growth(p);
-      c.dt = g.initial;
-      c.fixed = false;
-      steps = growth_step_count(p.time.end, g);
-    }
-  }
   c.steps = to_count(steps);
   c.wall_seconds = wall_seconds(p, scheme, steps, calibration);
   return c;
@@ -271,7 +231,11 @@ std::string scheme_advice(const Problem& p, std::int64_t max_steps,
   if (p.time.scheme != Scheme::quasi_static && p.time.end > 100 * crossing) {
     const SchemeCost q = scheme_cost(p, Scheme::quasi_static, calibration);
     if (static_cast<double>(q.steps) <= limit) {
-      const StepGrowth g = automatic_growth(p);
+      Problem automatic = p;  // the plan the solver follows when dt is absent
+      automatic.time.scheme = Scheme::quasi_static;
+      automatic.time.dt.reset();
+      automatic.time.growth.reset();
+      const StepGrowth g = stable_step(automatic).plan;
       std::string a = "use time.scheme 'quasi_static' (no inertia, any step is stable): about " +
                       format_count(static_cast<double>(q.steps)) +
                       " steps with dt {\"initial\": " + fmt(g.initial) +

@@ -14,6 +14,7 @@
 
 #include "cost_model.hpp"
 #include "hmpm/api/job.hpp"
+#include "hmpm/format.hpp"
 #include "test_support.hpp"
 
 namespace hmpm::api {
@@ -303,9 +304,15 @@ TEST(SchemeCosts, ConsolidationOverYearsIsReferredToQuasiStatic) {
   EXPECT_NE(m.find("about " + std::to_string(q.steps) + " steps with dt {\"initial\""),
             std::string::npos)
       << m;
-  // T_v = 1e-4 of H^2/c_v: c_v = k E_oed / gamma_w (m_v >> Q here).
-  const double c_v = 1e-9 / (1000 * 9.81 * (1 / 5e6 + 0.5 / 2.2e9));
-  EXPECT_NEAR(q.dt, 1e-4 * 25 / c_v, 1e-9 * q.dt);
+  // The solver's automatic plan starts at a tenth of the consolidation time
+  // of the smallest cell, 0.1 h^2 / c_v, c_v = k / (gamma_w (m_v + Q)).
+  const double e_oed = 5e6;  // column() has nu = 0
+  const double c_v = 1e-9 / (1000 * 9.81 * (1 / e_oed + 0.5 / 2.2e9));
+  const double h = 5.0 / 50;
+  EXPECT_NEAR(q.dt, 0.1 * h * h / c_v, 1e-6 * q.dt);
+  EXPECT_NE(m.find("with dt {\"initial\": " + hmpm::format_significant(q.dt, 3)),
+            std::string::npos)
+      << m;
   EXPECT_LT(q.steps, 100);
 }
 

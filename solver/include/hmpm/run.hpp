@@ -65,6 +65,10 @@ struct StableStep {
   /// true when every step is `chosen` long (the last one ends at time.end);
   /// false when the scheme picks each step (quasi_static growth/automatic).
   bool fixed = true;
+  /// Varying steps (fixed false): the geometric plan the scheme follows
+  /// (initial = chosen), before the steps are shortened to land on output
+  /// instants.
+  StepGrowth plan{};
 };
 
 /// Estimates the stable step for `problem` (automatic or user dt).

@@ -77,6 +77,7 @@ StableStep quasi_static_stable_step(const Problem& problem) {
   }
   const StepGrowth g = quasi_static_growth(problem);
   s.chosen = g.initial;
+  s.plan = g;
   s.steps = growth_step_count(g, end);
   s.fixed = false;
   return s;
