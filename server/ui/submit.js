@@ -9,7 +9,7 @@ import { line_of, locate, pointer_positions } from '/ui/jsonpos.js';
 
 const DEBOUNCE_MS = 500;
 // Used when the server has no /ui/examples/index.json.
-const KNOWN_EXAMPLES = ['bar-vibration', 'column-collapse', 'darcy-flow', 'geostatic', 'mandel', 'slope-failure', 'terzaghi'];
+const KNOWN_EXAMPLES = ['bar-vibration', 'column-collapse', 'darcy-flow', 'embankment', 'geostatic', 'mandel', 'slope-failure', 'soft-clay', 'terzaghi'];
 export const DRAFT_KEY = 'hmpm.draft';  // the editor's text, kept across visits
 
 // The expected wall time in seconds, wherever the server puts it.

@@ -16,8 +16,8 @@
 
 #include "output.hpp"
 #include "schemes/explicit_scheme.hpp"
-#include "schemes/semi_implicit_scheme.hpp"
 #include "schemes/quasi_static_scheme.hpp"
+#include "schemes/semi_implicit_scheme.hpp"
 #include "schemes/time_scheme.hpp"
 #include "simulation.hpp"
 

@@ -310,8 +310,7 @@ TEST(SchemeCosts, ConsolidationOverYearsIsReferredToQuasiStatic) {
   const double c_v = 1e-9 / (1000 * 9.81 * (1 / e_oed + 0.5 / 2.2e9));
   const double h = 5.0 / 50;
   EXPECT_NEAR(q.dt, 0.1 * h * h / c_v, 1e-6 * q.dt);
-  EXPECT_NE(m.find("with dt {\"initial\": " + hmpm::format_significant(q.dt, 3)),
-            std::string::npos)
+  EXPECT_NE(m.find("with dt {\"initial\": " + hmpm::format_significant(q.dt, 3)), std::string::npos)
       << m;
   EXPECT_LT(q.steps, 100);
 }
