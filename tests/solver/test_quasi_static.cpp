@@ -433,3 +433,113 @@ TEST(QuasiStatic, LargeSettlementEndsDrainedAndConservesSolidMass) {
   EXPECT_NEAR(settle, settle_exact, 0.03 * settle_exact);
   EXPECT_LT(max_x, 0.05);
 }
+
+// ------------------------------------------------------------------ solvers, dimensions
+// The iterative solver (BiCGSTAB + ILUT) solves the same saddle-point
+// systems as the direct one: the Mandel history agrees to the linear
+// tolerance (1e-12 relative, times the condition of the scaled system:
+// 1e-6 p0 is a loose bound).
+TEST(QuasiStatic, IterativeSolverMatchesDirect) {
+  QsMandel c;
+  hmpm::Problem p = qs_mandel(c);
+  p.time.end = c.time_of(0.1);
+  p.time.growth = hmpm::StepGrowth{c.time_of(1e-4), c.time_of(0.01), 1.2};
+  p.output.series_interval = c.time_of(0.01);
+  p.time.implicit.linear_solver = hmpm::LinearSolver::direct;
+  const hmpm::RunResult direct = hmpm::run(p);
+  p.time.implicit.linear_solver = hmpm::LinearSolver::iterative;
+  const hmpm::RunResult iterative = hmpm::run(p);
+  ASSERT_EQ(direct.status, hmpm::RunStatus::successful) << direct.message;
+  ASSERT_EQ(iterative.status, hmpm::RunStatus::successful) << iterative.message;
+  ASSERT_EQ(direct.series.values[0].size(), iterative.series.values[0].size());
+  double worst = 0;
+  for (std::size_t i = 0; i < direct.series.values[0].size(); ++i)
+    worst = std::max(worst, std::abs(direct.series.values[0][i] - iterative.series.values[0][i]));
+  std::printf(
+      "direct vs iterative: max |dp| / p0 = %.3g; %lld BiCGSTAB iterations in %lld solves\n",
+      worst / c.p0(), static_cast<long long>(iterative.iterations.linear),
+      static_cast<long long>(iterative.iterations.solves));
+  EXPECT_LT(worst, 1e-6 * c.p0());
+  EXPECT_EQ(direct.iterations.linear, 0);
+  EXPECT_GT(iterative.iterations.linear, 0);
+}
+
+// The same soft clay as a 2D and a 3D column (one cell across, roller
+// walls) matches the 1D run: the stencil abstraction is generic. 20 cells
+// (a smoke test; tolerances of the 1D case at 40 cells would be too tight):
+// the errors against Terzaghi agree with 1D to 1e-3 q.
+TEST(QuasiStatic, ColumnIn2DAnd3DMatches1D) {
+  ClayCase c;
+  c.cells = 20;
+  c.growth_max_tv = 0.005;
+  const ClayErrors one = run_clay(c);
+  for (int dim : {2, 3}) {
+    c.dim = dim;
+    const ClayErrors e = run_clay(c);
+    EXPECT_NEAR(e.pressure, one.pressure, 1e-3) << dim << "D";
+    EXPECT_NEAR(e.degree, one.degree, 1e-3) << dim << "D";
+    EXPECT_LT(e.pressure, 0.02) << dim << "D";
+  }
+}
+
+// ------------------------------------------------------------------ plasticity
+// A dry Mohr-Coulomb oedometer (phi = 30 deg, c = 0, psi = 0, nu = 0.1):
+// the elastic at-rest ratio nu/(1-nu) = 0.11 is below the active ratio
+// Ka = (1 - sin phi)/(1 + sin phi) = 1/3, so the loaded column yields and
+// ends at sigma_v = -q (equilibrium) and sigma_h = Ka sigma_v (on the
+// triaxial-compression corner of the yield surface). Newton with the
+// elastic tangent converges linearly at plastic points: the test also
+// bounds the iterations it needs.
+TEST(QuasiStatic, MohrCoulombOedometerReachesTheActiveRatio) {
+  hmpm::Problem p = problems::column(1, 0, 1.0, 10, 2);
+  hmpm::Material m;
+  m.name = "sand";
+  m.density = 2000;
+  m.youngs_modulus = 10e6;
+  m.poisson_ratio = 0.1;
+  m.plasticity = hmpm::MohrCoulomb{30.0, 0.0, 0.0, 0.0};
+  p.materials.push_back(m);
+  p.boundaries.push_back(problems::fixed_velocity(problems::plane(p, 0, 0.0), 0));
+  const double q = 1e5;
+  hmpm::Traction t;
+  t.particles.min = {1.0 - 0.05, 0, 0};
+  t.particles.max = {1.0, 1, 1};
+  t.axis = 0;
+  t.side = +1;
+  t.traction[0] = [q](double time) { return -q * std::min(1.0, time); };  // ramp over 1 s
+  p.tractions.push_back(t);
+  p.time.scheme = hmpm::Scheme::quasi_static;
+  p.time.end = 2.0;
+  p.time.dt = 0.1;
+  p.time.implicit.max_iterations = 60;
+  p.output.series_particles = {0, 5, 10, 15, 17};  // below the loaded top cell
+  p.output.series_fields = {hmpm::Field::effective_stress};
+  const hmpm::RunResult r = hmpm::run(p);
+  ASSERT_EQ(r.status, hmpm::RunStatus::successful) << r.message;
+  const hmpm::Series& s = r.series;
+  const std::size_t last = s.time.size() - 1;
+  const double ka = (1 - std::sin(closed_form::pi / 6)) / (1 + std::sin(closed_form::pi / 6));
+  double worst_v = 0, worst_h = 0;
+  const std::size_t np = s.particles.size();
+  for (std::size_t i = 0; i < np; ++i) {
+    const double sv = s.values[0][(last * np + i) * 6 + 0],
+                 sh = s.values[0][(last * np + i) * 6 + 1];
+    worst_v = std::max(worst_v, std::abs(sv + q) / q);
+    worst_h = std::max(worst_h, std::abs(sh - ka * sv) / q);
+  }
+  std::printf(
+      "Mohr-Coulomb oedometer: max |sigma_v + q|/q = %.3g, max |sigma_h - Ka sigma_v|/q = %.3g; "
+      "%lld Newton iterations in %lld steps (at most %d in one)\n",
+      worst_v, worst_h, static_cast<long long>(r.iterations.nonlinear),
+      static_cast<long long>(r.steps), r.iterations.max_nonlinear);
+  // The vertical stress: -q up to the particle quadrature of compressed
+  // cells (the particles fill 1 - eps of each cell, eps = 1 %, so nodal
+  // equilibrium gives sigma = -q / (1 - eps)); 2 %. The top cell is left
+  // out: the load lands inside it, at the particle's face, and splits
+  // between its nodes. The yield condition (sigma_h = Ka sigma_v on the
+  // triaxial-compression corner): to 1e-6 q (return mapping and Newton
+  // tolerance).
+  EXPECT_LT(worst_v, 0.02);
+  EXPECT_LT(worst_h, 1e-6);
+  EXPECT_GT(r.iterations.max_nonlinear, 1);  // plastic steps need more than one
+}
