@@ -182,9 +182,9 @@ struct QsMandel {
   double stabilisation = 1.0;
   hmpm::ShapeFunction shape = hmpm::ShapeFunction::linear;
   double h() const { return a / cells; }
-  double G() const { return E / (2 * (1 + nu)); }
+  double shear_modulus() const { return E / (2 * (1 + nu)); }
   double lambda() const { return E * nu / ((1 + nu) * (1 - 2 * nu)); }
-  double c() const { return k / gamma_w * (lambda() + 2 * G()); }
+  double c() const { return k / gamma_w * (lambda() + 2 * shear_modulus()); }
   double p0() const { return q / 2; }  // F B (1 + nu_u) / (3 a), B = 1, nu_u = 1/2
   double time_of(double T) const { return T * a * a / c(); }
 };
@@ -241,6 +241,7 @@ double checkerboard(const hmpm::Series& s, std::size_t row, double p0, double a)
     if (s.initial_positions[i][1] < ymin + 1e-9 && s.initial_positions[i][0] < 0.5 * a)
       line[s.initial_positions[i][0]] = s.values[0][row * np + i];
   std::vector<double> v;
+  v.reserve(line.size());
   for (const auto& kv : line) v.push_back(kv.second);
   double worst = 0;
   for (std::size_t i = 1; i + 1 < v.size(); ++i)
@@ -253,11 +254,13 @@ struct MandelErrors {
   hmpm::RunResult result;
 };
 
-MandelErrors run_qs_mandel(const QsMandel& c, double T_end, double dT, double T0 = 1e-4) {
+MandelErrors run_qs_mandel(const QsMandel& c, double end_star, double sample_star,
+                           double first_star = 1e-4) {
   hmpm::Problem p = qs_mandel(c);
-  p.time.end = c.time_of(T_end);
-  p.time.growth = hmpm::StepGrowth{c.time_of(T0), c.time_of(dT), 1.2};
-  p.output.series_interval = T0 >= dT ? c.time_of(dT) : 0.0;  // 0: every step
+  p.time.end = c.time_of(end_star);
+  p.time.growth = hmpm::StepGrowth{c.time_of(first_star), c.time_of(sample_star), 1.2};
+  p.output.series_interval =
+      first_star >= sample_star ? c.time_of(sample_star) : 0.0;  // 0: every step
   MandelErrors e;
   e.result = hmpm::run(p);
   EXPECT_EQ(e.result.status, hmpm::RunStatus::successful) << e.result.message;
