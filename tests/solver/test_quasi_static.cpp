@@ -546,3 +546,42 @@ TEST(QuasiStatic, MohrCoulombOedometerReachesTheActiveRatio) {
   EXPECT_LT(worst_h, 1e-6);
   EXPECT_GT(r.iterations.max_nonlinear, 1);  // plastic steps need more than one
 }
+
+// ------------------------------------------------------------------ step plans
+// The three plans: a fixed dt (fixed steps, ceil(end/dt) of them), growth,
+// and automatic (dt0 = 0.1 h^2/c_v, growth 1.2 up to end/20). Varying steps
+// land on the output instants, and the step estimate is the plan's count
+// (the landings add at most one step per output instant).
+TEST(QuasiStatic, StepPlansAndOutputLandings) {
+  ClayCase c;
+  hmpm::Problem p = clay(c, c.time_of(1.0));
+  p.output.series_interval = c.time_of(0.1);
+  p.time.growth.reset();
+  const hmpm::StableStep automatic = hmpm::stable_step(p);
+  EXPECT_FALSE(automatic.fixed);
+  const double h = c.H / c.cells;
+  EXPECT_NEAR(automatic.chosen, 0.1 * h * h / c.cv(), 1e-9 * automatic.chosen);
+  const hmpm::RunResult r = hmpm::run(p);
+  ASSERT_EQ(r.status, hmpm::RunStatus::successful) << r.message;
+  EXPECT_GE(r.steps, automatic.steps);
+  EXPECT_LE(r.steps, automatic.steps + 10);  // 10 output instants
+  ASSERT_EQ(r.series.time.size(), 11u);
+  for (std::size_t row = 0; row < r.series.time.size(); ++row)
+    EXPECT_NEAR(r.series.time[row], static_cast<double>(row) * c.time_of(0.1),
+                1e-9 * c.time_of(1.0));
+  std::printf("automatic plan: dt0 = %.3g s, estimate %lld steps, ran %lld\n", automatic.chosen,
+              static_cast<long long>(automatic.steps), static_cast<long long>(r.steps));
+  p.time.dt = c.time_of(0.03);
+  const hmpm::StableStep fixed = hmpm::stable_step(p);
+  EXPECT_TRUE(fixed.fixed);
+  EXPECT_EQ(fixed.steps, 34);  // ceil(1 / 0.03)
+  const hmpm::RunResult rf = hmpm::run(p);
+  ASSERT_EQ(rf.status, hmpm::RunStatus::successful) << rf.message;
+  EXPECT_EQ(rf.steps, 34);
+  // A fixed dt together with a growth object is refused.
+  p.time.growth = hmpm::StepGrowth{1.0, 2.0, 1.1};
+  const auto issues = hmpm::check_problem(p);
+  bool named = false;
+  for (const auto& i : issues) named = named || i.message.find("keep one") != std::string::npos;
+  EXPECT_TRUE(named);
+}
