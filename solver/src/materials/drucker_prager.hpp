@@ -10,6 +10,7 @@
 #include <Eigen/Core>
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 
 #include "elastic.hpp"
@@ -102,6 +103,102 @@ inline DruckerPragerConstants make_drucker_prager(const hmpm::DruckerPrager& m) 
   const double dq = q - q_new, dpm = p - p_new;
   // ||d eps_p||^2 = ||ds||^2/(4G^2) + 3 (dp/(3K))^2, with ||ds|| = sqrt(2) dq.
   return std::sqrt(dq * dq / (2.0 * g * g) + dpm * dpm / (3.0 * bulk * bulk));
+}
+
+/// Where a Drucker-Prager return lands (the tests of return_drucker_prager).
+enum class DruckerPragerRegion : std::uint8_t { elastic, cone, cut_off, corner, apex };
+
+/// The region return_drucker_prager takes for the trial stress `stress`:
+/// the same tests in the same arithmetic, so the two always agree.
+inline DruckerPragerRegion drucker_prager_region(const Voigt& stress, const Elastic& el,
+                                                 const DruckerPragerConstants& dp) {
+  const double p = (stress(0) + stress(1) + stress(2)) / 3.0;
+  const double dx = stress(0) - p, dy = stress(1) - p, dz = stress(2) - p;
+  const double q = std::sqrt(0.5 * (dx * dx + dy * dy + dz * dz) + stress(3) * stress(3) +
+                             stress(4) * stress(4) + stress(5) * stress(5));
+  const double f = q + dp.alpha * p - dp.k;
+  const double pt = dp.mean_tension_cutoff;
+  if (f <= 0.0 && p <= pt) return DruckerPragerRegion::elastic;
+  const double g = el.shear, bulk = el.lambda + 2.0 * g / 3.0;
+  const double tol = 1e-13 * (std::abs(p) + q + dp.k);
+  if (f > 0.0) {
+    const double dl = f / (g + bulk * dp.alpha * dp.alpha_psi);
+    const double qc = q - g * dl, pc = p - bulk * dp.alpha_psi * dl;
+    if (qc >= 0.0 && pc <= pt + tol)
+      return qc == 0.0 ? DruckerPragerRegion::apex : DruckerPragerRegion::cone;
+  }
+  if (p > pt && q + dp.alpha * pt - dp.k <= 0.0)
+    return q == 0.0 ? DruckerPragerRegion::apex : DruckerPragerRegion::cut_off;
+  return std::max(dp.k - dp.alpha * pt, 0.0) == 0.0 ? DruckerPragerRegion::apex
+                                                    : DruckerPragerRegion::corner;
+}
+
+/// Drucker-Prager return with its algorithmic tangent. `stress` is the
+/// trial stress on entry and the returned stress on exit, bit for bit what
+/// return_drucker_prager gives (it does the return); `d_alg` receives
+/// d sigma_{n+1} / d eps_{n+1} (elastic.hpp's convention) of the map
+/// eps_{n+1} -> return(sigma_n + D_e (eps_{n+1} - eps_n)). Closed form, with
+/// p, q = sqrt(J2), s the trial deviator, 1 = (1,1,1,0,0,0), P the deviatoric
+/// projector (diag 1 on the shears) and m = (s_xx, s_yy, s_zz, 2 s_xy, 2 s_yz,
+/// 2 s_zx)/q, so that dq = G m . d eps and dp = K 1 . d eps:
+///  * elastic: D_e;
+///  * cone: sigma = p' 1 + (q'/q) s with dl = f/h, h = G + K alpha alpha_psi,
+///    p' = p - K alpha_psi dl, q' = q - G dl; differentiating,
+///      D = 1 (x) dp' + (q'/q) 2G P + s (x) (dq' - (q'/q) G m)/q,
+///      df = G m + alpha K 1, dp' = K 1 - K alpha_psi df/h, dq' = G m - G df/h
+///    (symmetric for associated flow, alpha_psi = alpha);
+///  * cut-off (p' = p_t, deviator kept): D = 2G P, no volumetric stiffness;
+///  * corner (p' = p_t, q' = k - alpha p_t fixed): D = (q'/q) 2G (P - s (x) m/(2q)),
+///    the derivative of a radial return to a fixed radius: stiffness only
+///    tangential to the deviatoric circle;
+///  * apex (the stress is the fixed point p_t 1): D = 0, no stiffness at all.
+/// Returns ||d eps_p|| as return_drucker_prager does.
+inline double return_drucker_prager_with_tangent(Voigt& stress, const Elastic& el,
+                                                 const DruckerPragerConstants& dp, Tangent& d_alg) {
+  const Voigt trial = stress;
+  const DruckerPragerRegion region = drucker_prager_region(trial, el, dp);
+  const double plastic = return_drucker_prager(stress, el, dp);
+  const double g = el.shear, bulk = el.lambda + 2.0 * g / 3.0;
+  const double p = (trial(0) + trial(1) + trial(2)) / 3.0;
+  Voigt s = trial, one = Voigt::Zero();
+  s.head<3>().array() -= p;
+  one.head<3>().setOnes();
+  Tangent proj = Tangent::Identity();  // deviatoric projector P
+  proj.topLeftCorner<3, 3>().array() -= 1.0 / 3.0;
+  const double q = std::sqrt(0.5 * s.head<3>().squaredNorm() + s.tail<3>().squaredNorm());
+  Voigt m = s;
+  if (q > 0.0) {
+    m.tail<3>() *= 2.0;
+    m /= q;
+  }
+  switch (region) {
+    case DruckerPragerRegion::elastic:
+      d_alg = elastic_tangent(el);
+      break;
+    case DruckerPragerRegion::cone: {
+      const double h = g + bulk * dp.alpha * dp.alpha_psi;
+      const double f = q + dp.alpha * p - dp.k;
+      const double ratio = (q - g * f / h) / q;
+      const Voigt df = g * m + dp.alpha * bulk * one;
+      const Voigt dp_new = bulk * one - (bulk * dp.alpha_psi / h) * df;
+      const Voigt dq_new = g * m - (g / h) * df;
+      d_alg = one * dp_new.transpose() + (ratio * 2.0 * g) * proj +
+              s * ((dq_new - ratio * g * m) / q).transpose();
+      break;
+    }
+    case DruckerPragerRegion::cut_off:
+      d_alg = 2.0 * g * proj;
+      break;
+    case DruckerPragerRegion::corner: {
+      const double ratio = (dp.k - dp.alpha * dp.mean_tension_cutoff) / q;
+      d_alg = (ratio * 2.0 * g) * (proj - s * m.transpose() / (2.0 * q));
+      break;
+    }
+    case DruckerPragerRegion::apex:
+      d_alg.setZero();
+      break;
+  }
+  return plastic;
 }
 
 /// The model as the stress update sees it (see MohrCoulombModel).

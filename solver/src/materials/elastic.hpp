@@ -17,6 +17,17 @@
 // plastic multiplier of the unit-normalised plastic potential; it is also
 // the increment of the usual accumulated plastic strain, and 0 exactly when
 // the step was elastic (the stress is then left bitwise untouched).
+//
+// Tangents (for the implicit schemes): each model also has a return that
+// reports the algorithmic (consistent) tangent D_alg = d sigma_{n+1} /
+// d eps_{n+1} of its stress update, a 6x6 `Tangent` in the same Voigt order.
+// The strain columns are TENSOR strain components, as the explicit stress
+// update uses them (de_xy = (dv_x/dy + dv_y/dx) dt / 2, sigma_xy += 2G de_xy):
+// the elastic tangent's shear diagonal is 2G, not G. A column j of D_alg is
+// the stress response to a unit change of the Voigt strain component j, the
+// shear ones changing eps_ab and eps_ba together. An assembly written with
+// engineering shear strains gamma = 2 eps uses D_alg with its shear columns
+// (3..5) halved.
 #pragma once
 
 #include <Eigen/Core>
@@ -24,6 +35,8 @@
 namespace hmpm::constitutive {
 
 using Voigt = Eigen::Matrix<double, 6, 1>;
+/// d sigma / d eps in Voigt xx, yy, zz, xy, yz, zx, tensor shear strains (see above).
+using Tangent = Eigen::Matrix<double, 6, 6>;
 
 /// Linear isotropic elasticity: Lame's lambda and the shear modulus G, Pa (G > 0).
 struct Elastic {
@@ -55,5 +68,14 @@ inline Eigen::Matrix3d to_tensor(const Voigt& v) {
 }
 
 }  // namespace detail
+
+/// The elastic tangent in the convention above: lambda 1 (x) 1 + 2G I on the
+/// normal block, 2G on the shear diagonal (tensor shear strains).
+inline Tangent elastic_tangent(const Elastic& el) {
+  Tangent d = Tangent::Zero();
+  d.topLeftCorner<3, 3>().setConstant(el.lambda);
+  d.diagonal().array() += 2.0 * el.shear;
+  return d;
+}
 
 }  // namespace hmpm::constitutive

@@ -139,6 +139,37 @@ inline void return_to_yield_surface(constitutive::Voigt& sig, const MaterialCons
   }
 }
 
+/// The material's elastic tangent d sigma / d eps (Voigt xx yy zz xy yz zx,
+/// tensor shear strains: 2G on the shear diagonal; materials/elastic.hpp).
+inline constitutive::Tangent elastic_tangent(const MaterialConstants& mc) {
+  return constitutive::elastic_tangent(mc.elastic);
+}
+
+/// return_to_yield_surface with the algorithmic (consistent) tangent, for
+/// Newton iterations of the implicit schemes. `sig` holds the elastic trial
+/// sigma_n + D_e (eps_{n+1} - eps_n) on entry and the returned stress on exit
+/// (bit for bit return_to_yield_surface's); `d_alg` receives
+/// d sigma_{n+1} / d eps_{n+1} in the convention of elastic_tangent (the
+/// elastic tangent for linear-elastic materials and elastic steps).
+/// Returns ||d eps_p||, 0 when the step was elastic. Not for hot loops of
+/// the explicit scheme: it costs a spectral derivative per plastic point.
+inline double return_with_tangent(constitutive::Voigt& sig, const MaterialConstants& mc,
+                                  [[maybe_unused]] InternalState state,
+                                  constitutive::Tangent& d_alg) {
+  switch (mc.model) {
+    case Model::mohr_coulomb:
+      return constitutive::return_mohr_coulomb_with_tangent(sig, mc.elastic, mc.mohr_coulomb,
+                                                            d_alg);
+    case Model::drucker_prager:
+      return constitutive::return_drucker_prager_with_tangent(sig, mc.elastic, mc.drucker_prager,
+                                                              d_alg);
+    case Model::linear_elastic:
+      break;
+  }
+  d_alg = constitutive::elastic_tangent(mc.elastic);
+  return 0.0;
+}
+
 inline double darcy_inertia_growth_ratio(const MaterialConstants& c) {
   if (!c.saturated || c.darcy_inertia_density <= 0.0 || c.permeability_over_gamma <= 0.0)
     return 0.0;
