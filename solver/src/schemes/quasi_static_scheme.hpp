@@ -407,11 +407,11 @@ class QuasiStaticScheme final : public TimeScheme {
   static constexpr int NC = Dim == 1 ? 1 : (Dim == 2 ? 3 : 6);
   static constexpr int component(int i) { return Dim == 2 && i == 2 ? 3 : i; }
 
-  /// The stiffness block of nodes k, l with the tangent d (times `scale`):
-  /// K_kl = scale Bhat_k^T d B_l, B_l the strain of a unit displacement of
-  /// node l (tensor shear: eps_xy = (g_y u_x + g_x u_y) / 2), Bhat_k its
-  /// work-conjugate (engineering shear, twice B's shear rows: the internal
-  /// force is V sigma grad N, where sigma_xy acts on both x and y).
+  /// The strain-displacement matrix of a node with shape gradient gk, shear
+  /// rows times `shear`: 1/2 gives B, the tensor strain of a unit nodal
+  /// displacement (eps_xy = (g_y u_x + g_x u_y) / 2); 1 gives Bhat, its work
+  /// conjugate (the internal force V sigma grad N, where sigma_xy acts on
+  /// both x and y). The stiffness block of nodes k, l: V Bhat_k^T D B_l.
   static Eigen::Matrix<double, NC, Dim> strain_of(const Vec& gk, double shear) {
     Eigen::Matrix<double, NC, Dim> b = Eigen::Matrix<double, NC, Dim>::Zero();
     for (int a = 0; a < Dim; ++a) b(a, a) = gk[a];
