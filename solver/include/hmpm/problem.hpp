@@ -222,6 +222,10 @@ struct ImplicitControl {
   /// 1/(2G) of equal-order u-p (docs/schemes.md); 0 turns it off (tests only:
   /// near-incompressible water then shows the checkerboard it removes).
   double pressure_stabilisation = 1.0;
+  /// quasi_static: Newton with the elastic stiffness at plastic points
+  /// instead of the algorithmic (consistent) tangent; linear instead of
+  /// quadratic convergence. Not in the JSON: for tests that compare the two.
+  bool elastic_tangent = false;
 };
 
 struct TimeControl {

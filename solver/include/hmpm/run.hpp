@@ -180,6 +180,10 @@ struct RunResult {
     std::int64_t solves = 0;     ///< linear systems solved
     std::int64_t cutbacks = 0;   ///< steps halved because Newton did not converge
     int max_nonlinear = 0;       ///< most Newton iterations in one step
+    /// quasi_static: the scaled residual max(|R_u|/|f|, |R_p|/|terms|) at
+    /// each Newton iteration (0 = the initial guess) of the first step that
+    /// took max_nonlinear iterations: shows the rate of convergence.
+    std::vector<double> worst_residuals;
   } iterations;
   Series series;
 };

@@ -65,7 +65,7 @@ bool UpSystem::solve(const Eigen::VectorXd& b, Eigen::VectorXd& x) {
     return x.allFinite();
   }
   s.bicgstab.setTolerance(tolerance_);
-  s.bicgstab.setMaxIterations(static_cast<int>(std::min<std::int64_t>(10 * n_ + 100, 100000)));
+  s.bicgstab.setMaxIterations(2000);  // measured: 3 to 35 iterations (2D, 2k to 190k unknowns)
   s.bicgstab.preconditioner().setDroptol(1e-4);
   s.bicgstab.preconditioner().setFillfactor(20);
   s.bicgstab.compute(matrix_);

@@ -29,9 +29,16 @@
 // and R_p), is the symmetric indefinite
 //   [ K / E_ref      -C              ]   K = sum V B^T D B, C = sum V B^T m N
 //   [ -C^T           -E_ref (S + dt H + tau P) ]
-// with the elastic D (exact for elastic materials; plastic points use the
-// elastic tangent too until the algorithmic tangents exist, so Newton
-// converges linearly there).
+// with D the elastic stiffness at elastic points and the algorithmic
+// (consistent) tangent d sigma / d eps of the return mapping at plastic
+// points (materials/material.hpp return_with_tangent; tensor shear strains,
+// so K = sum V Bhat^T D B with B the tensor-strain and Bhat the engineering
+// (work-conjugate) strain-displacement matrix; plane strain takes the xx,
+// yy, xy rows and columns). Newton then converges quadratically; the
+// non-associated tangents are unsymmetric (the solvers are LU/BiCGSTAB).
+// Left out of the Jacobian: the Jaumann spin of sigma^n and the change of
+// the particle volumes (small in a step). time.implicit.elastic_tangent
+// (tests only) takes the elastic D everywhere: linear convergence.
 //
 // Boundary conditions: prescribed velocity components give prescribed
 // increments (the trapezoidal integral of the velocity over the step),
@@ -143,6 +150,7 @@ class QuasiStaticScheme final : public TimeScheme {
     result.iterations.solves = system_.solves;
     result.iterations.cutbacks = cutbacks_;
     result.iterations.max_nonlinear = max_nonlinear_;
+    result.iterations.worst_residuals = worst_;
   }
 
  private:
@@ -309,9 +317,13 @@ class QuasiStaticScheme final : public TimeScheme {
     for (std::size_t i = 0; i < nodes; ++i) grid.force[i].setZero();
     apply_dead_loads(t + h);
     const ImplicitControl& c = sim_.problem_.time.implicit;
+    history_.resize(static_cast<std::size_t>(c.max_iterations) + 1);  // no-op after the first
     for (int it = 0;; ++it) {
       const bool converged = assemble(h, /*jacobian=*/it < c.max_iterations);
+      history_[static_cast<std::size_t>(it)] = std::max(last_ru_, last_rp_);
       if (converged) {
+        if (it > max_nonlinear_ || worst_.empty())
+          worst_.assign(history_.begin(), history_.begin() + it + 1);
         max_nonlinear_ = std::max(max_nonlinear_, it);
         commit(h);
         return !sim_.failed_;
@@ -357,8 +369,12 @@ class QuasiStaticScheme final : public TimeScheme {
   }
 
   /// The particle's strain increment and trial-then-returned stress for the
-  /// current du; grad du in `g`.
-  void particle_stress(std::size_t p, const StencilT& s, Mat& g, Voigt& de, Voigt& sig) const {
+  /// current du; grad du in `g`. With `d_alg`, the algorithmic tangent of
+  /// the return too (d sigma / d eps, tensor shear strains); the return
+  /// value then says whether the point was plastic (d_alg is only written
+  /// when it was; elastic points take the elastic stiffness).
+  bool particle_stress(std::size_t p, const StencilT& s, Mat& g, Voigt& de, Voigt& sig,
+                       constitutive::Tangent* d_alg = nullptr) const {
     g.setZero();
     for (int k = 0; k < N; ++k) {
       const auto i = static_cast<std::size_t>(s.node[k]);
@@ -379,7 +395,39 @@ class QuasiStaticScheme final : public TimeScheme {
     const double tr = de[0] + de[1] + de[2];
     for (int c = 0; c < 3; ++c) sig[c] += mc.lambda * tr + 2.0 * mc.shear_modulus * de[c];
     for (int c = 3; c < 6; ++c) sig[c] += 2.0 * mc.shear_modulus * de[c];
-    if (sim_.plastic_) return_to_yield_surface(sig, mc, {sim_.particles_.internal.data(), p});
+    if (!sim_.plastic_) return false;
+    if (d_alg && mc.model != Model::linear_elastic)
+      return return_with_tangent(sig, mc, {sim_.particles_.internal.data(), p}, *d_alg) > 0.0;
+    return_to_yield_surface(sig, mc, {sim_.particles_.internal.data(), p});
+    return false;
+  }
+
+  /// The Voigt components of a Dim-dimensional strain (plane strain in 2D:
+  /// xx, yy, xy; 1D: xx).
+  static constexpr int NC = Dim == 1 ? 1 : (Dim == 2 ? 3 : 6);
+  static constexpr int component(int i) { return Dim == 2 && i == 2 ? 3 : i; }
+
+  /// The strain-displacement matrix of a node with shape gradient gk, shear
+  /// rows times `shear`: 1/2 gives B, the tensor strain of a unit nodal
+  /// displacement (eps_xy = (g_y u_x + g_x u_y) / 2); 1 gives Bhat, its work
+  /// conjugate (the internal force V sigma grad N, where sigma_xy acts on
+  /// both x and y). The stiffness block of nodes k, l: V Bhat_k^T D B_l.
+  static Eigen::Matrix<double, NC, Dim> strain_of(const Vec& gk, double shear) {
+    Eigen::Matrix<double, NC, Dim> b = Eigen::Matrix<double, NC, Dim>::Zero();
+    for (int a = 0; a < Dim; ++a) b(a, a) = gk[a];
+    if constexpr (Dim == 2) {
+      b(2, 0) = shear * gk[1];
+      b(2, 1) = shear * gk[0];
+    }
+    if constexpr (Dim == 3) {
+      b(3, 0) = shear * gk[1];  // xy
+      b(3, 1) = shear * gk[0];
+      b(4, 1) = shear * gk[2];  // yz
+      b(4, 2) = shear * gk[1];
+      b(5, 2) = shear * gk[0];  // zx
+      b(5, 0) = shear * gk[2];
+    }
+    return b;
   }
 
   /// Residual (rhs_ = scaled R, ref_ = the sums of the magnitudes of its
@@ -403,6 +451,9 @@ class QuasiStaticScheme final : public TimeScheme {
     StencilT s;
     std::int64_t dofs[L];
     Eigen::Matrix<double, L, L> a_loc;
+    constitutive::Tangent d_alg;
+    Eigen::Matrix<double, NC, Dim> db[N];  // tangent times the strain of node l
+    const bool consistent_off = sim_.problem_.time.implicit.elastic_tangent;
     for (std::size_t p = 0; p < parts.size(); ++p) {
       sim_.template stencil_in_step<true, true>(p, s);
       local_dofs(s, dofs);
@@ -410,7 +461,8 @@ class QuasiStaticScheme final : public TimeScheme {
       const bool sat = sim_.fluid_ && mc.saturated;
       Mat g;
       Voigt de, sig;
-      particle_stress(p, s, g, de, sig);
+      const bool plastic =
+          particle_stress(p, s, g, de, sig, jacobian && !consistent_off ? &d_alg : nullptr);
       const double vol = parts.volume[p], m = parts.mass[p];
       const Mat vs = vol * Sim::active_stress(sig);
       double p_hat = 0.0, div = g.trace();
@@ -446,17 +498,32 @@ class QuasiStaticScheme final : public TimeScheme {
         }
       }
       if (!jacobian) continue;
-      // Local Jacobian (elastic tangent), scaled as in the file comment.
+      // Local Jacobian, scaled as in the file comment: the elastic
+      // stiffness (lambda, G), or at plastic points the algorithmic tangent.
       const double lam = mc.lambda * vol * inv_e, sh = mc.shear_modulus * vol * inv_e;
+      if (plastic) {
+        Eigen::Matrix<double, NC, NC> dr;
+        for (int i = 0; i < NC; ++i)
+          for (int j = 0; j < NC; ++j) dr(i, j) = d_alg(component(i), component(j)) * vol * inv_e;
+        for (int l = 0; l < N; ++l) db[l].noalias() = dr * strain_of(s.grad(l), 0.5);
+      }
       for (int k = 0; k < N; ++k) {
         const Vec gk = s.grad(k);
+        Eigen::Matrix<double, NC, Dim> bk = Eigen::Matrix<double, NC, Dim>::Zero();
+        if (plastic) bk = strain_of(gk, 1.0);
         for (int l = 0; l < N; ++l) {
           const Vec gl = s.grad(l);
           const double gg = gk.dot(gl);
-          for (int a = 0; a < Dim; ++a)
-            for (int b = 0; b < Dim; ++b)
-              a_loc(k * (Dim + 1) + a, l * (Dim + 1) + b) =
-                  lam * gk[a] * gl[b] + sh * (gk[b] * gl[a] + (a == b ? gg : 0.0));
+          if (plastic) {
+            const Eigen::Matrix<double, Dim, Dim> kl = bk.transpose() * db[l];
+            for (int a = 0; a < Dim; ++a)
+              for (int b = 0; b < Dim; ++b) a_loc(k * (Dim + 1) + a, l * (Dim + 1) + b) = kl(a, b);
+          } else {
+            for (int a = 0; a < Dim; ++a)
+              for (int b = 0; b < Dim; ++b)
+                a_loc(k * (Dim + 1) + a, l * (Dim + 1) + b) =
+                    lam * gk[a] * gl[b] + sh * (gk[b] * gl[a] + (a == b ? gg : 0.0));
+          }
           for (int a = 0; a < Dim; ++a) {
             a_loc(k * (Dim + 1) + a, l * (Dim + 1) + Dim) = sat ? -vol * gk[a] * s.w[l] : 0.0;
             a_loc(k * (Dim + 1) + Dim, l * (Dim + 1) + a) = sat ? -vol * s.w[k] * gl[a] : 0.0;
@@ -584,6 +651,7 @@ class QuasiStaticScheme final : public TimeScheme {
   UpSystem system_;
 
   double last_ru_ = 0.0, last_rp_ = 0.0;
+  std::vector<double> history_, worst_;  ///< residuals of this step / of the worst one
   std::int64_t nonlinear_ = 0, cutbacks_ = 0;
   int max_nonlinear_ = 0;
 };
