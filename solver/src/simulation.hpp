@@ -107,7 +107,8 @@ class Simulation {
   // The semi-implicit scheme's phases (phases/pressure_projection.hpp).
   void map_predicted_velocity(const Out& out, std::size_t begin, std::size_t end, double dt);
   void map_predicted_fluid_flux(const Out& out, std::size_t begin, std::size_t end);
-  void assemble_pressure_laplacian(double dt, double* box, std::uint8_t* active);
+  void assemble_pressure_laplacian(std::size_t begin, std::size_t end, double dt, double* box,
+                                   std::uint8_t* active, std::int64_t first);
   void map_pressure_increment_force(const Out& out, std::size_t begin, std::size_t end);
 
   // ------------------------------------------------------------ threads

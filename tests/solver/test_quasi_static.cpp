@@ -601,7 +601,8 @@ struct BiaxialResult {
   double s1 = 0, s3 = 0, spread = 0;  // mean vertical, lateral stress (compression +)
 };
 
-BiaxialResult biaxial(bool drucker_prager, bool elastic_tangent, int dim = 2) {
+BiaxialResult biaxial(bool drucker_prager, bool elastic_tangent, int dim = 2,
+                      const hmpm::RunOptions& options = {}, double tolerance = 1e-8) {
   hmpm::Problem p;
   p.dimension = dim;
   p.grid.min = {0, 0, 0};
@@ -646,11 +647,12 @@ BiaxialResult biaxial(bool drucker_prager, bool elastic_tangent, int dim = 2) {
   p.time.dt = 0.05;
   p.time.implicit.max_iterations = 200;
   p.time.implicit.elastic_tangent = elastic_tangent;
+  p.time.implicit.tolerance = tolerance;
   const auto n = hmpm::count_particles(p);
   for (std::int64_t i = 0; i < n; ++i) p.output.series_particles.push_back(i);
   p.output.series_fields = {hmpm::Field::effective_stress};
   BiaxialResult r;
-  r.run = hmpm::run(p);
+  r.run = hmpm::run(p, options);
   if (r.run.status != hmpm::RunStatus::successful) return r;
   const hmpm::Series& s = r.run.series;
   const std::size_t last = s.time.size() - 1, np = s.particles.size();
@@ -726,6 +728,56 @@ TEST(QuasiStatic, PlaneStrainCompressionReachesTheClosedFormStrength) {
   EXPECT_NEAR(r3.s1, r3.s3 * kp + 2 * c * std::sqrt(kp), 1e-6 * r2.s1);
   EXPECT_NEAR(r3.s1, r2.s1, 1e-5 * r2.s1);
   EXPECT_LE(r3.run.iterations.max_nonlinear, 3);
+}
+
+// ------------------------------------------------------------------ threads
+// The assembly and the particle update run on the solver threads (issue
+// 16): each thread sums its chunk of particles into private copies of the
+// residual and the matrix values, added in thread order. Two runs at 2
+// threads are identical; 1 and 2 threads differ only in the order of the
+// sums, round-off (1e-16 per operation) that the converged Newton steps do
+// not amplify: 1e-12 of the largest value over the whole history. Mandel
+// (u-p coupling, stabilisation, tied plate) and the Drucker-Prager
+// plane-strain compression (algorithmic tangents at plastic points). The
+// iterations stop anywhere below the Newton tolerance, so two round-off
+// paths agree only to about it: the compression runs at tolerance 1e-12
+// (at the default 1e-8 measured 7e-11; Mandel is linear, one iteration).
+double history_difference(const hmpm::RunResult& a, const hmpm::RunResult& b) {
+  EXPECT_EQ(a.status, hmpm::RunStatus::successful) << a.message;
+  EXPECT_EQ(b.status, hmpm::RunStatus::successful) << b.message;
+  EXPECT_EQ(a.series.values[0].size(), b.series.values[0].size());
+  if (a.series.values[0].size() != b.series.values[0].size()) return inf;
+  double worst = 0, scale = 0;
+  for (std::size_t i = 0; i < a.series.values[0].size(); ++i) {
+    worst = std::max(worst, std::abs(a.series.values[0][i] - b.series.values[0][i]));
+    scale = std::max(scale, std::abs(a.series.values[0][i]));
+  }
+  return scale > 0 ? worst / scale : worst;
+}
+
+TEST(QuasiStatic, ThreadsAgree) {
+  hmpm::RunOptions one, two;
+  two.threads = 2;
+  two.min_particles_per_thread = 1;
+  QsMandel c;
+  hmpm::Problem p = qs_mandel(c);
+  p.time.end = c.time_of(0.05);
+  p.time.growth = hmpm::StepGrowth{c.time_of(1e-4), c.time_of(0.01), 1.5};
+  const hmpm::RunResult m1 = hmpm::run(p, one), m2 = hmpm::run(p, two), m2b = hmpm::run(p, two);
+  EXPECT_EQ(m1.threads, 1);
+  EXPECT_EQ(m2.threads, 2);
+  const double dm = history_difference(m1, m2);
+  EXPECT_EQ(history_difference(m2, m2b), 0.0);
+  const BiaxialResult b1 = biaxial(true, false, 2, one, 1e-12),
+                      b2 = biaxial(true, false, 2, two, 1e-12),
+                      b2b = biaxial(true, false, 2, two, 1e-12);
+  EXPECT_EQ(b2.run.threads, 2);
+  const double db = history_difference(b1.run, b2.run);
+  EXPECT_EQ(history_difference(b2.run, b2b.run), 0.0);
+  std::printf("threads 1 vs 2: Mandel %.3g, Drucker-Prager compression %.3g (relative)\n", dm, db);
+  EXPECT_LT(dm, 1e-12);
+  EXPECT_LT(db, 1e-12);
+  EXPECT_EQ(b1.run.iterations.nonlinear, b2.run.iterations.nonlinear);
 }
 
 // ------------------------------------------------------------------ step plans

@@ -13,6 +13,7 @@
 #pragma once
 
 #include <Eigen/SparseCore>
+#include <algorithm>
 #include <cstdint>
 #include <memory>
 #include <vector>
@@ -42,6 +43,18 @@ class UpSystem {
   /// Adds v to entry (r, c), which must be in the pattern.
   void add(std::int64_t r, std::int64_t c, double v) {
     matrix_.coeffRef(static_cast<int>(r), static_cast<int>(c)) += v;
+  }
+
+  /// The values of the pattern's entries (column-major, compressed), and
+  /// the position in them of entry (r, c), which must be in the pattern:
+  /// threaded assembly adds into private copies of the values and sums them
+  /// into values() in thread order (schemes/quasi_static_scheme.hpp).
+  double* values() { return matrix_.valuePtr(); }
+  std::int64_t nonzeros() const { return matrix_.nonZeros(); }
+  std::int64_t offset(std::int64_t r, std::int64_t c) const {
+    const int* inner = matrix_.innerIndexPtr();
+    const int* outer = matrix_.outerIndexPtr();
+    return std::lower_bound(inner + outer[c], inner + outer[c + 1], static_cast<int>(r)) - inner;
   }
 
   /// Solves A x = b with the current values. False when the factorisation

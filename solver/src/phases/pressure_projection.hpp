@@ -96,19 +96,24 @@ inline void Simulation<Dim, Shape>::map_predicted_velocity(const Out& out, std::
   }
 }
 
-/// The pressure Laplacian of the projection, serially over the particles:
-/// box[i][o] += c_p V_p grad N_i . grad N_j for node j >= i (the lower
-/// triangle by columns), with c_p = dt^2/rho_p + dt k/gw (1 - rho_f/rho_p)
-/// (rho_p = m_p/V_p; rho_f the Darcy-inertia density, 0 when dropped).
-/// Marks every node of a saturated particle's stencil in `active`.
+/// The pressure Laplacian of the projection over the particles [begin,
+/// end): box[(i - first) Box::size + o] += c_p V_p grad N_i . grad N_j for
+/// node j >= i (the lower triangle by columns), with c_p = dt^2/rho_p + dt
+/// k/gw (1 - rho_f/rho_p) (rho_p = m_p/V_p; rho_f the Darcy-inertia
+/// density, 0 when dropped). Marks every node of a saturated particle's
+/// stencil in active[i - first]. `first` is the lowest node the particles'
+/// stencils reach (0 for the whole grid; a thread's private box covers its
+/// band of nodes only).
 template <int Dim, class Shape>
-inline void Simulation<Dim, Shape>::assemble_pressure_laplacian(double dt, double* box,
-                                                                std::uint8_t* active) {
+inline void Simulation<Dim, Shape>::assemble_pressure_laplacian(std::size_t begin, std::size_t end,
+                                                                double dt, double* box,
+                                                                std::uint8_t* active,
+                                                                std::int64_t first) {
   using Box = CouplingBox<Dim, Shape::K>;
   static_assert(Box::nodes == StencilT::N);
   static constexpr auto offsets = Box::offsets();
   StencilT s;
-  for (std::size_t p = 0; p < particles_.size(); ++p) {
+  for (std::size_t p = begin; p < end; ++p) {
     const MaterialConstants& mc = constants_[particles_.material[p]];
     if (!mc.saturated) continue;
     stencil_in_step<true, true>(p, s);
@@ -118,8 +123,8 @@ inline void Simulation<Dim, Shape>::assemble_pressure_laplacian(double dt, doubl
                                                 (1.0 - mc.darcy_inertia_density / rho));
     for (int k = 0; k < StencilT::N; ++k) {
       const std::int64_t i = s.node[k];
-      active[i] = 1;
-      double* const row = box + i * Box::size;
+      active[i - first] = 1;
+      double* const row = box + (i - first) * Box::size;
       const Vec gk = c * s.grad(k);
       const auto& off = offsets[static_cast<std::size_t>(k)];
       for (int l = 0; l < StencilT::N; ++l)

@@ -47,6 +47,13 @@
 // frictionless (only their normal component is prescribed), prescribed pore
 // pressures take their value at t + dt.
 //
+// Threads: the residual and Jacobian assembly takes one fixed chunk of
+// particles per solver thread, each extra thread into private copies of the
+// residual and the matrix values (same pattern; sized once per step), added
+// in thread order after the loop: reproducible at a given thread count,
+// round-off between counts. The particle update takes blocks dynamically
+// (no sums). The per-step set-up and the linear solve are serial.
+//
 // A step whose Newton iterations do not converge within max_iterations is
 // halved and retried, up to max_cutbacks halvings; then the run fails with
 // the residual reached and what to change.
@@ -246,6 +253,14 @@ class QuasiStaticScheme final : public TimeScheme {
                            sim_.problem_.time.implicit.linear_tolerance);
     rhs_.resize(unknowns_);
     ref_.resize(unknowns_);
+    // Private sums of threads 1.. (zero between assemblies; no allocation
+    // once the vectors have reached the largest pattern).
+    partial_.resize(sim_.pool_ ? static_cast<std::size_t>(sim_.pool_->size() - 1) : 0);
+    for (Partial& w : partial_) {
+      w.rhs.assign(static_cast<std::size_t>(unknowns_), 0.0);
+      w.ref.assign(static_cast<std::size_t>(unknowns_), 0.0);
+      w.values.assign(static_cast<std::size_t>(system_.nonzeros()), 0.0);
+    }
     x_.resize(unknowns_);
     du_.assign(nodes * Dim, 0.0);
     p_.assign(nodes, 0.0);
@@ -439,7 +454,6 @@ class QuasiStaticScheme final : public TimeScheme {
     ref_.setZero();
     if (jacobian) system_.zero_values();
     const double inv_e = 1.0 / e_ref_;
-    const Vec gravity = sim_.gravity_;
     // Tractions.
     for (std::size_t i = 0; i < static_cast<std::size_t>(grid.count); ++i)
       for (int a = 0; a < Dim; ++a) {
@@ -448,95 +462,45 @@ class QuasiStaticScheme final : public TimeScheme {
         rhs_[d] += grid.force[i][a] * inv_e;
         ref_[d] += std::abs(grid.force[i][a]) * inv_e;
       }
-    StencilT s;
-    std::int64_t dofs[L];
-    Eigen::Matrix<double, L, L> a_loc;
-    constitutive::Tangent d_alg;
-    Eigen::Matrix<double, NC, Dim> db[N];  // tangent times the strain of node l
-    const bool consistent_off = sim_.problem_.time.implicit.elastic_tangent;
-    for (std::size_t p = 0; p < parts.size(); ++p) {
-      sim_.template stencil_in_step<true, true>(p, s);
-      local_dofs(s, dofs);
-      const MaterialConstants& mc = sim_.constants_[parts.material[p]];
-      const bool sat = sim_.fluid_ && mc.saturated;
-      Mat g;
-      Voigt de, sig;
-      const bool plastic =
-          particle_stress(p, s, g, de, sig, jacobian && !consistent_off ? &d_alg : nullptr);
-      const double vol = parts.volume[p], m = parts.mass[p];
-      const Mat vs = vol * Sim::active_stress(sig);
-      double p_hat = 0.0, div = g.trace();
-      Vec grad_p = Vec::Zero();
-      if (sat)
-        for (int k = 0; k < N; ++k) {
-          const double pk = p_[static_cast<std::size_t>(s.node[k])];
-          p_hat += s.w[k] * pk;
-          grad_p += pk * s.grad(k);
-        }
-      const double storage = sat ? (1.0 - parts.porosity[p]) * sim_.inv_ks_[parts.material[p]] +
-                                       parts.porosity[p] * sim_.inv_kf_[parts.material[p]]
-                                 : 0.0;
-      const double kg = sat ? mc.permeability_over_gamma : 0.0;
-      const Vec flow = grad_p - mc.fluid_density * gravity;
-      const double p_old = sat ? parts.pressure_out[p] : 0.0;
-      for (int k = 0; k < N; ++k) {
-        const Vec gk = s.grad(k);
-        const Vec fs = vs * gk, fp = (vol * p_hat) * gk, fg = (s.w[k] * m) * gravity;
-        for (int a = 0; a < Dim; ++a) {
-          const std::int64_t d = dofs[k * (Dim + 1) + a];
-          if (d < 0) continue;
-          rhs_[d] += (fg[a] - fs[a] + fp[a]) * inv_e;
-          ref_[d] += (std::abs(fg[a]) + std::abs(fs[a]) + std::abs(fp[a])) * inv_e;
-        }
-        const std::int64_t dp = dofs[k * (Dim + 1) + Dim];
-        if (sat && dp >= 0) {
-          const double r1 = vol * s.w[k] * storage * (p_hat - p_old);
-          const double r2 = vol * s.w[k] * div;
-          const double r3 = h * vol * kg * gk.dot(flow);
-          rhs_[dp] += r1 + r2 + r3;
-          ref_[dp] += std::abs(r1) + std::abs(r2) + std::abs(r3);
-        }
+    // The particles, in one fixed chunk per thread: thread 0 adds into
+    // rhs_, ref_ and the matrix, thread t > 0 into its private copies
+    // (partial_), which are then added in thread order, entry by entry, and
+    // cleared: the sums are reproducible for a given thread count.
+    auto chunk = [&](int t, std::size_t b, std::size_t e) {
+      if (t == 0) {
+        assemble_particles(b, e, h, jacobian, rhs_.data(), ref_.data(),
+                           jacobian ? system_.values() : nullptr);
+        return;
       }
-      if (!jacobian) continue;
-      // Local Jacobian, scaled as in the file comment: the elastic
-      // stiffness (lambda, G), or at plastic points the algorithmic tangent.
-      const double lam = mc.lambda * vol * inv_e, sh = mc.shear_modulus * vol * inv_e;
-      if (plastic) {
-        Eigen::Matrix<double, NC, NC> dr;
-        for (int i = 0; i < NC; ++i)
-          for (int j = 0; j < NC; ++j) dr(i, j) = d_alg(component(i), component(j)) * vol * inv_e;
-        for (int l = 0; l < N; ++l) db[l].noalias() = dr * strain_of(s.grad(l), 0.5);
-      }
-      for (int k = 0; k < N; ++k) {
-        const Vec gk = s.grad(k);
-        Eigen::Matrix<double, NC, Dim> bk = Eigen::Matrix<double, NC, Dim>::Zero();
-        if (plastic) bk = strain_of(gk, 1.0);
-        for (int l = 0; l < N; ++l) {
-          const Vec gl = s.grad(l);
-          const double gg = gk.dot(gl);
-          if (plastic) {
-            const Eigen::Matrix<double, Dim, Dim> kl = bk.transpose() * db[l];
-            for (int a = 0; a < Dim; ++a)
-              for (int b = 0; b < Dim; ++b) a_loc(k * (Dim + 1) + a, l * (Dim + 1) + b) = kl(a, b);
-          } else {
-            for (int a = 0; a < Dim; ++a)
-              for (int b = 0; b < Dim; ++b)
-                a_loc(k * (Dim + 1) + a, l * (Dim + 1) + b) =
-                    lam * gk[a] * gl[b] + sh * (gk[b] * gl[a] + (a == b ? gg : 0.0));
+      Partial& w = partial_[static_cast<std::size_t>(t - 1)];
+      assemble_particles(b, e, h, jacobian, w.rhs.data(), w.ref.data(),
+                         jacobian ? w.values.data() : nullptr);
+    };
+    if (partial_.empty()) {
+      chunk(0, 0, parts.size());
+    } else {
+      sim_.pool_->for_ranges(parts.size(), chunk);
+      double* values = system_.values();
+      const auto unknowns = static_cast<std::size_t>(unknowns_);
+      const auto entries = static_cast<std::size_t>(system_.nonzeros());
+      auto reduce = [&](int, std::size_t b, std::size_t e) {
+        for (Partial& w : partial_) {
+          if (b < unknowns)
+            for (std::size_t k = b; k < std::min(e, unknowns); ++k) {
+              rhs_[static_cast<Eigen::Index>(k)] += w.rhs[k];
+              ref_[static_cast<Eigen::Index>(k)] += w.ref[k];
+              w.rhs[k] = 0.0;
+              w.ref[k] = 0.0;
+            }
+          if (!jacobian) continue;
+          for (std::size_t k = b; k < std::min(e, entries); ++k) {
+            values[k] += w.values[k];
+            w.values[k] = 0.0;
           }
-          for (int a = 0; a < Dim; ++a) {
-            a_loc(k * (Dim + 1) + a, l * (Dim + 1) + Dim) = sat ? -vol * gk[a] * s.w[l] : 0.0;
-            a_loc(k * (Dim + 1) + Dim, l * (Dim + 1) + a) = sat ? -vol * s.w[k] * gl[a] : 0.0;
-          }
-          a_loc(k * (Dim + 1) + Dim, l * (Dim + 1) + Dim) =
-              sat ? -e_ref_ * vol * (storage * s.w[k] * s.w[l] + h * kg * gg) : 0.0;
         }
-      }
-      for (int r = 0; r < L; ++r) {
-        if (dofs[r] < 0) continue;
-        for (int c = 0; c < L; ++c)
-          if (dofs[c] >= 0 && a_loc(r, c) != 0.0) system_.add(dofs[r], dofs[c], a_loc(r, c));
-      }
+      };
+      const std::size_t n = std::max(unknowns, jacobian ? entries : 0);
+      sim_.pool_->for_blocks(n, sim_.block_of(n, Sim::node_block), reduce);
     }
     // Pressure stabilisation on the increment p - p^n.
     const std::size_t cells = cell_nodes_.size() / N;
@@ -581,13 +545,122 @@ class QuasiStaticScheme final : public TimeScheme {
     return last_ru_ <= tol && last_rp_ <= tol;
   }
 
+  /// The particles [begin, end) of assemble(): their residual terms added
+  /// to rhs and ref and, when `jacobian`, their Jacobian entries to values
+  /// (laid out as UpSystem::values()).
+  void assemble_particles(std::size_t begin, std::size_t end, double h, bool jacobian, double* rhs,
+                          double* ref, double* values) {
+    auto& parts = sim_.particles_;
+    const double inv_e = 1.0 / e_ref_;
+    const Vec gravity = sim_.gravity_;
+    StencilT s;
+    std::int64_t dofs[L];
+    Eigen::Matrix<double, L, L> a_loc;
+    constitutive::Tangent d_alg;
+    Eigen::Matrix<double, NC, Dim> db[N];  // tangent times the strain of node l
+    const bool consistent_off = sim_.problem_.time.implicit.elastic_tangent;
+    for (std::size_t p = begin; p < end; ++p) {
+      sim_.template stencil_in_step<true, true>(p, s);
+      local_dofs(s, dofs);
+      const MaterialConstants& mc = sim_.constants_[parts.material[p]];
+      const bool sat = sim_.fluid_ && mc.saturated;
+      Mat g;
+      Voigt de, sig;
+      const bool plastic =
+          particle_stress(p, s, g, de, sig, jacobian && !consistent_off ? &d_alg : nullptr);
+      const double vol = parts.volume[p], m = parts.mass[p];
+      const Mat vs = vol * Sim::active_stress(sig);
+      double p_hat = 0.0, div = g.trace();
+      Vec grad_p = Vec::Zero();
+      if (sat)
+        for (int k = 0; k < N; ++k) {
+          const double pk = p_[static_cast<std::size_t>(s.node[k])];
+          p_hat += s.w[k] * pk;
+          grad_p += pk * s.grad(k);
+        }
+      const double storage = sat ? (1.0 - parts.porosity[p]) * sim_.inv_ks_[parts.material[p]] +
+                                       parts.porosity[p] * sim_.inv_kf_[parts.material[p]]
+                                 : 0.0;
+      const double kg = sat ? mc.permeability_over_gamma : 0.0;
+      const Vec flow = grad_p - mc.fluid_density * gravity;
+      const double p_old = sat ? parts.pressure_out[p] : 0.0;
+      for (int k = 0; k < N; ++k) {
+        const Vec gk = s.grad(k);
+        const Vec fs = vs * gk, fp = (vol * p_hat) * gk, fg = (s.w[k] * m) * gravity;
+        for (int a = 0; a < Dim; ++a) {
+          const std::int64_t d = dofs[k * (Dim + 1) + a];
+          if (d < 0) continue;
+          rhs[d] += (fg[a] - fs[a] + fp[a]) * inv_e;
+          ref[d] += (std::abs(fg[a]) + std::abs(fs[a]) + std::abs(fp[a])) * inv_e;
+        }
+        const std::int64_t dp = dofs[k * (Dim + 1) + Dim];
+        if (sat && dp >= 0) {
+          const double r1 = vol * s.w[k] * storage * (p_hat - p_old);
+          const double r2 = vol * s.w[k] * div;
+          const double r3 = h * vol * kg * gk.dot(flow);
+          rhs[dp] += r1 + r2 + r3;
+          ref[dp] += std::abs(r1) + std::abs(r2) + std::abs(r3);
+        }
+      }
+      if (!jacobian) continue;
+      // Local Jacobian, scaled as in the file comment: the elastic
+      // stiffness (lambda, G), or at plastic points the algorithmic tangent.
+      const double lam = mc.lambda * vol * inv_e, sh = mc.shear_modulus * vol * inv_e;
+      if (plastic) {
+        Eigen::Matrix<double, NC, NC> dr;
+        for (int i = 0; i < NC; ++i)
+          for (int j = 0; j < NC; ++j) dr(i, j) = d_alg(component(i), component(j)) * vol * inv_e;
+        for (int l = 0; l < N; ++l) db[l].noalias() = dr * strain_of(s.grad(l), 0.5);
+      }
+      for (int k = 0; k < N; ++k) {
+        const Vec gk = s.grad(k);
+        Eigen::Matrix<double, NC, Dim> bk = Eigen::Matrix<double, NC, Dim>::Zero();
+        if (plastic) bk = strain_of(gk, 1.0);
+        for (int l = 0; l < N; ++l) {
+          const Vec gl = s.grad(l);
+          const double gg = gk.dot(gl);
+          if (plastic) {
+            const Eigen::Matrix<double, Dim, Dim> kl = bk.transpose() * db[l];
+            for (int a = 0; a < Dim; ++a)
+              for (int b = 0; b < Dim; ++b) a_loc(k * (Dim + 1) + a, l * (Dim + 1) + b) = kl(a, b);
+          } else {
+            for (int a = 0; a < Dim; ++a)
+              for (int b = 0; b < Dim; ++b)
+                a_loc(k * (Dim + 1) + a, l * (Dim + 1) + b) =
+                    lam * gk[a] * gl[b] + sh * (gk[b] * gl[a] + (a == b ? gg : 0.0));
+          }
+          for (int a = 0; a < Dim; ++a) {
+            a_loc(k * (Dim + 1) + a, l * (Dim + 1) + Dim) = sat ? -vol * gk[a] * s.w[l] : 0.0;
+            a_loc(k * (Dim + 1) + Dim, l * (Dim + 1) + a) = sat ? -vol * s.w[k] * gl[a] : 0.0;
+          }
+          a_loc(k * (Dim + 1) + Dim, l * (Dim + 1) + Dim) =
+              sat ? -e_ref_ * vol * (storage * s.w[k] * s.w[l] + h * kg * gg) : 0.0;
+        }
+      }
+      for (int r = 0; r < L; ++r) {
+        if (dofs[r] < 0) continue;
+        for (int c = 0; c < L; ++c)
+          if (dofs[c] >= 0 && a_loc(r, c) != 0.0)
+            values[system_.offset(dofs[r], dofs[c])] += a_loc(r, c);
+      }
+    }
+  }
+
   /// The converged step: particles take the stress, strain, volume,
   /// porosity, pressure and Darcy velocity of du and p, and move by N du.
   void commit(double h) {
+    // Each particle's update is its own (no sums): blocks on any thread.
+    sim_.for_particles(0u, [&](const auto&, std::size_t begin, std::size_t end) {
+      commit_particles(begin, end, h);
+    });
+    prepared_ = false;
+  }
+
+  void commit_particles(std::size_t begin, std::size_t end, double h) {
     auto& parts = sim_.particles_;
     auto& grid = sim_.grid_;
     StencilT s;
-    for (std::size_t p = 0; p < parts.size(); ++p) {
+    for (std::size_t p = begin; p < end; ++p) {
       sim_.template stencil_in_step<true, true>(p, s);
       Mat g;
       Voigt de, sig;
@@ -631,7 +704,6 @@ class QuasiStaticScheme final : public TimeScheme {
           sim_.fail_left_grid(p);
       }
     }
-    prepared_ = false;
   }
 
   Sim& sim_;
@@ -649,6 +721,10 @@ class QuasiStaticScheme final : public TimeScheme {
   std::vector<double> cell_matrix_;                          ///< N x N per cell
   Eigen::VectorXd rhs_, ref_, x_;
   UpSystem system_;
+  struct Partial {
+    std::vector<double> rhs, ref, values;  ///< as rhs_, ref_, UpSystem::values()
+  };
+  std::vector<Partial> partial_;  ///< threads 1.. of assemble()
 
   double last_ru_ = 0.0, last_rp_ = 0.0;
   std::vector<double> history_, worst_;  ///< residuals of this step / of the worst one

@@ -28,10 +28,11 @@
 // the explicit step.
 //
 // Linear algebra: linear/pressure_system.hpp (Eigen sparse LDL^T or
-// conjugate gradients with incomplete Cholesky). Assembly of the Laplacian
-// is serial (over particles, into a per-node box of couplings); the
-// predicted re-map, the flux and the corrector's force are threaded like
-// the explicit phases.
+// conjugate gradients with incomplete Cholesky). The Laplacian is assembled
+// over the particles into a per-node box of couplings, threaded like the
+// explicit phases (private boxes over each thread's band of nodes, added in
+// thread order), as are the predicted re-map, the flux and the corrector's
+// force.
 #pragma once
 
 #include <Eigen/Core>
@@ -143,7 +144,7 @@ class SemiImplicitScheme final : public TimeScheme {
     sim_.for_nodes([&](std::int64_t b, std::int64_t e) {
       for (std::int64_t i = b; i < e; ++i) grid.remap[i].setZero();
     });
-    sim_.assemble_pressure_laplacian(dt, box_.data(), active_.data());
+    assemble_laplacian(dt);
     std::fill(grid.dp.begin(), grid.dp.end(), 0.0);
     apply_pressure_increment_constraints(sim_.constraints_, grid, t + dt);
     // Unknowns: active, free nodes with a positive diagonal, in node order.
@@ -296,6 +297,65 @@ class SemiImplicitScheme final : public TimeScheme {
     });
   }
 
+  /// The Laplacian into box_ and active_, over one fixed chunk of particles
+  /// per thread (the chunks of the step's first phase, whose band of nodes
+  /// Simulation::touched_ records): thread 0 straight into box_, thread t >
+  /// 0 into a private box over its band, added to box_ after the loop,
+  /// node by node in thread order, and cleared: the sums are reproducible
+  /// for a given thread count.
+  void assemble_laplacian(double dt) {
+    const std::size_t threads = sim_.touched_.size();
+    bands_.resize(threads);
+    for (std::size_t t = 1; t < threads; ++t) {
+      const NodeRange r = sim_.touched_[t];
+      Band& band = bands_[t];
+      band.first = r.lo;
+      const auto nodes = static_cast<std::size_t>(std::max<std::int64_t>(0, r.hi - r.lo + 1));
+      if (band.active.size() < nodes) {  // grows to the largest band, then stays
+        band.box.resize(nodes * Box::size, 0.0);
+        band.active.resize(nodes, 0);
+      }
+    }
+    auto chunk = [&](int t, std::size_t b, std::size_t e) {
+      if (t == 0) {
+        sim_.assemble_pressure_laplacian(b, e, dt, box_.data(), active_.data(), 0);
+        return;
+      }
+      Band& band = bands_[static_cast<std::size_t>(t)];
+      sim_.assemble_pressure_laplacian(b, e, dt, band.box.data(), band.active.data(), band.first);
+    };
+    sim_.pool_->for_ranges(sim_.particles_.size(), chunk);
+    if (threads < 2) return;
+    std::int64_t lo = sim_.grid_.count, hi = -1;
+    for (std::size_t t = 1; t < threads; ++t) {
+      lo = std::min(lo, sim_.touched_[t].lo);
+      hi = std::max(hi, sim_.touched_[t].hi);
+    }
+    if (hi < lo) return;
+    auto reduce = [&](int, std::size_t b, std::size_t e) {
+      for (std::size_t t = 1; t < threads; ++t) {
+        Band& band = bands_[t];
+        const std::int64_t first = std::max(lo + static_cast<std::int64_t>(b), band.first);
+        const std::int64_t last =
+            std::min(lo + static_cast<std::int64_t>(e), sim_.touched_[t].hi + 1);
+        for (std::int64_t i = first; i < last; ++i) {
+          const auto u = static_cast<std::size_t>(i), v = static_cast<std::size_t>(i - band.first);
+          if (!band.active[v]) continue;
+          band.active[v] = 0;
+          active_[u] = 1;
+          double* const to = box_.data() + u * Box::size;
+          double* const from = band.box.data() + v * Box::size;
+          for (int o = 0; o < Box::size; ++o) {
+            to[o] += from[o];
+            from[o] = 0.0;
+          }
+        }
+      }
+    };
+    const auto nodes = static_cast<std::size_t>(hi - lo + 1);
+    sim_.pool_->for_blocks(nodes, sim_.block_of(nodes, Sim::node_block), reduce);
+  }
+
   Sim& sim_;
   PressureSystem system_;
   // Per node (saturated runs): the Laplacian's couplings (zero between
@@ -308,6 +368,12 @@ class SemiImplicitScheme final : public TimeScheme {
   std::vector<std::int64_t> node_of_;
   std::vector<double> rhs_, x_, last_dp_;
   std::array<std::int64_t, Box::size> node_offset_{};
+  struct Band {
+    std::int64_t first = 0;            ///< its lowest node
+    std::vector<double> box;           ///< as box_, from node `first`
+    std::vector<std::uint8_t> active;  ///< as active_, from node `first`
+  };
+  std::vector<Band> bands_;  ///< per thread (1..) of assemble_laplacian
   std::int64_t solves_ = 0, linear_iterations_ = 0;
 };
 
