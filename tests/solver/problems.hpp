@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cmath>
+#include <limits>
 
 #include "hmpm/problem.hpp"
 
@@ -60,6 +61,39 @@ inline hmpm::Boundary fixed_pressure(const hmpm::NodeSelection& nodes, double va
   b.nodes = nodes;
   b.pore_pressure = constant(value);
   return b;
+}
+
+/// A linear elastic saturated material (incompressible grains, water of
+/// density 1000 kg/m^3 and bulk modulus kw).
+inline hmpm::Material saturated_elastic(double rho_s, double e, double nu, double porosity,
+                                        double k, double kw) {
+  hmpm::Material m;
+  m.name = "clay";
+  m.density = rho_s;
+  m.youngs_modulus = e;
+  m.poisson_ratio = nu;
+  m.hydraulic = hmpm::Hydraulic{porosity, k, kw, 1000.0, std::numeric_limits<double>::infinity()};
+  return m;
+}
+
+/// Terzaghi's consolidation on a column() of height h along `axis` with
+/// `cells` x `ppc` particles along it: the base (x_axis = 0) fixed, p = 0 on
+/// the node plane x_axis = drained_at (h: the loaded top; 0: the base), the
+/// load q on the top row of particles, carried by the water at t = 0 (zero
+/// effective stress, p = q).
+inline void load_consolidation(hmpm::Problem& p, int axis, double h, int cells, int ppc, double q,
+                               double drained_at) {
+  p.bodies[0].initial.pore_pressure = [q](const hmpm::Vec3&) { return q; };
+  p.boundaries.push_back(fixed_velocity(plane(p, axis, 0.0), axis));
+  p.boundaries.push_back(fixed_pressure(plane(p, axis, drained_at), 0.0));
+  hmpm::Traction t;
+  t.particles.min = p.grid.min;
+  t.particles.max = p.grid.max;
+  t.particles.min[axis] = h - h / (cells * ppc);  // the top row of particles
+  t.axis = axis;
+  t.side = +1;
+  t.traction[axis] = constant(-q);
+  p.tractions.push_back(t);
 }
 
 }  // namespace problems

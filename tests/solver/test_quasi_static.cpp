@@ -42,32 +42,17 @@ struct ClayCase {
 hmpm::Problem clay(const ClayCase& c, double end) {
   const int axis = c.dim - 1;  // vertical axis: the last one
   hmpm::Problem p = problems::column(c.dim, axis, c.H, c.cells, c.ppc);
-  hmpm::Material m;
+  hmpm::Material m = problems::saturated_elastic(c.rho_s, c.E, c.nu, c.porosity, c.k, c.kw);
   m.name = "soft clay";
-  m.density = c.rho_s;
-  m.youngs_modulus = c.E;
-  m.poisson_ratio = c.nu;
-  m.hydraulic = hmpm::Hydraulic{c.porosity, c.k, c.kw, 1000.0, inf};
   p.materials.push_back(m);
-  const double q = c.q;
   // The state just after loading: the water carries the load (as in the
   // explicit Terzaghi test; with Kw = 2.2 GPa the undrained share of the
   // skeleton is Q/(m_v + Q) = 0.15 %, which c_v with Q accounts for).
-  p.bodies[0].initial.pore_pressure = [q](const hmpm::Vec3&) { return q; };
-  p.boundaries.push_back(problems::fixed_velocity(problems::plane(p, axis, 0.0), axis));
   // Drained through the fixed base: a pressure condition acts on grid nodes,
   // and the loaded top moves by up to 0.8 h over the consolidation, away
   // from the node plane z = H (which would then drain less and less). The
   // solution is Terzaghi's with z measured from the base.
-  p.boundaries.push_back(problems::fixed_pressure(problems::plane(p, axis, 0.0), 0.0));
-  hmpm::Traction t;
-  t.particles.min = p.grid.min;
-  t.particles.max = p.grid.max;
-  t.particles.min[axis] = c.H - c.H / (c.cells * c.ppc);
-  t.axis = axis;
-  t.side = +1;
-  t.traction[axis] = problems::constant(-q);
-  p.tractions.push_back(t);
+  problems::load_consolidation(p, axis, c.H, c.cells, c.ppc, c.q, 0.0);
   p.time.end = end;
   p.time.scheme = hmpm::Scheme::quasi_static;
   p.time.growth = hmpm::StepGrowth{c.time_of(c.initial_tv), c.time_of(c.growth_max_tv), 1.2};

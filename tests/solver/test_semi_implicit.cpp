@@ -45,26 +45,8 @@ hmpm::Problem terzaghi(const Column& c, double end) {
   }
   p.bodies[0].box.max = p.grid.max;
   p.shape_function = c.shape;
-  hmpm::Material m;
-  m.name = "clay";
-  m.density = c.rho_s;
-  m.youngs_modulus = c.E;
-  m.poisson_ratio = c.nu;
-  m.hydraulic =
-      hmpm::Hydraulic{c.porosity, c.k, c.kw, 1000.0, std::numeric_limits<double>::infinity()};
-  p.materials.push_back(m);
-  const double q = c.q;
-  p.bodies[0].initial.pore_pressure = [q](const hmpm::Vec3&) { return q; };
-  p.boundaries.push_back(problems::fixed_velocity(problems::plane(p, c.axis, 0.0), c.axis));
-  p.boundaries.push_back(problems::fixed_pressure(problems::plane(p, c.axis, c.H), 0.0));
-  hmpm::Traction t;
-  t.particles.min = p.grid.min;
-  t.particles.max = p.grid.max;
-  t.particles.min[c.axis] = c.H - c.H / (c.cells * c.ppc);  // the top row of particles
-  t.axis = c.axis;
-  t.side = +1;
-  t.traction[c.axis] = problems::constant(-q);
-  p.tractions.push_back(t);
+  p.materials.push_back(problems::saturated_elastic(c.rho_s, c.E, c.nu, c.porosity, c.k, c.kw));
+  problems::load_consolidation(p, c.axis, c.H, c.cells, c.ppc, c.q, c.H);
   p.time.end = end;
   p.time.scheme = c.scheme;
   p.time.implicit.linear_solver = c.solver;

@@ -70,8 +70,11 @@ std::vector<TractionLoad> compile_tractions(const Problem& problem,
 }
 
 /// Surface loads at time t, mapped at the loaded face of each selected
-/// particle and added to the nodal force.
-template <int Dim, class Shape>
+/// particle and added to the nodal force. The face's area follows the
+/// particle's volume, V / length0 (a follower load: the explicit schemes);
+/// DeadLoad keeps its initial area V0 / length0 (a load fixed in size: the
+/// quasi-static scheme, whose Terzaghi and Mandel loads are fixed forces).
+template <int Dim, class Shape, bool DeadLoad = false>
 inline void apply_tractions(const std::vector<TractionLoad>& tractions,
                             const ParticleState<Dim>& particles, GridState<Dim>& grid, double t) {
   using Vec = VecD<Dim>;
@@ -84,7 +87,7 @@ inline void apply_tractions(const std::vector<TractionLoad>& tractions,
     for (std::size_t k = 0; k < load.particles.size(); ++k) {
       const auto p = static_cast<std::size_t>(load.particles[k]);
       const double stretch = std::pow(particles.volume[p] / load.volume0[k], 1.0 / Dim);
-      const double area = particles.volume[p] / load.length0[k];
+      const double area = (DeadLoad ? load.volume0[k] : particles.volume[p]) / load.length0[k];
       Vec face = particles.x[p];
       face[load.axis] += load.side * 0.5 * load.length0[k] * stretch;
       s.compute(face, grid.origin, grid.inv_h, grid.cells, grid.stride,

@@ -356,31 +356,13 @@ class QuasiStaticScheme final : public TimeScheme {
     }
   }
 
-  /// Surface loads at time t as dead loads: the force of each loaded
-  /// particle face is the traction times its initial area (volume0 /
-  /// length0), mapped at the face's current position. (The explicit
-  /// scheme's apply_tractions scales the area with (V/V0)^((d-1)/d), which
-  /// in uniaxial compression lowers the load by the top particle's strain;
-  /// Terzaghi's and Mandel's loads are fixed forces.)
+  /// Surface loads at time t as dead loads: each loaded particle face keeps
+  /// its initial area (boundary/tractions.hpp; the explicit schemes' area
+  /// follows the particle volume, which in uniaxial compression lowers the
+  /// load by the top particle's strain; Terzaghi's and Mandel's loads are
+  /// fixed forces).
   void apply_dead_loads(double t) {
-    auto& parts = sim_.particles_;
-    auto& grid = sim_.grid_;
-    StencilT s;
-    for (const TractionLoad& load : sim_.tractions_) {
-      Vec traction;
-      for (int a = 0; a < Dim; ++a)
-        traction[a] = load.source->traction[a] ? load.source->traction[a](t) : 0.0;
-      for (std::size_t k = 0; k < load.particles.size(); ++k) {
-        const auto p = static_cast<std::size_t>(load.particles[k]);
-        const double stretch = std::pow(parts.volume[p] / load.volume0[k], 1.0 / Dim);
-        const double area = load.volume0[k] / load.length0[k];
-        Vec face = parts.x[p];
-        face[load.axis] += load.side * 0.5 * load.length0[k] * stretch;
-        s.compute(face, grid.origin, grid.inv_h, grid.cells, grid.stride,
-                  parts.half_length.empty() ? 0.0 : parts.half_length[p]);
-        for (int n = 0; n < N; ++n) grid.force[s.node[n]] += s.w[n] * area * traction;
-      }
-    }
+    apply_tractions<Dim, Shape, /*DeadLoad=*/true>(sim_.tractions_, sim_.particles_, sim_.grid_, t);
   }
 
   /// The particle's strain increment and trial-then-returned stress for the
