@@ -211,8 +211,10 @@ enum class LinearSolver {
 
 /// Convergence controls of the implicit schemes (ignored by the explicit one).
 struct ImplicitControl {
-  /// Newton converges when the residual norm falls below tolerance times
-  /// its norm at the start of the step (and the correction likewise).
+  /// Newton converges when, for each equation (equilibrium and the mass
+  /// balance), the residual norm falls below tolerance times the norm of
+  /// the magnitudes of the terms that make it up (a load-scaled measure:
+  /// it does not depend on how far the step started from equilibrium).
   double tolerance = 1e-8;
   int max_iterations = 25;  ///< Newton iterations per step before a cut-back
   int max_cutbacks = 8;     ///< halvings of a step before the run fails
