@@ -12,7 +12,11 @@ while [ $# -gt 0 ]; do
   if [ "$1" = "--target" ]; then shift; targets=("$@"); break; fi
   configure+=("$1"); shift
 done
-cmake -S . -B build -DCMAKE_BUILD_TYPE=Release "${configure[@]}" >/dev/null
+# Ninja when it is there (it keeps both cores busy across libraries); a build
+# directory configured before keeps its generator.
+generator=()
+if [ ! -f build/CMakeCache.txt ] && command -v ninja >/dev/null; then generator=(-G Ninja); fi
+cmake -S . -B build "${generator[@]}" -DCMAKE_BUILD_TYPE=Release "${configure[@]}" >/dev/null
 if [ ${#targets[@]} -gt 0 ]; then
   cmake --build build -j "$jobs" --target "${targets[@]}"
 else

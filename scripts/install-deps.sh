@@ -5,7 +5,7 @@
 set -euo pipefail
 
 packages=(
-  build-essential cmake pkg-config git curl
+  build-essential cmake ninja-build pkg-config git curl   # ninja: parallel builds (scripts/build.sh)
   libeigen3-dev            # solver: linear algebra (header only)
   nlohmann-json3-dev       # api: JSON parsing
   libmuparser-dev          # api: expressions in job specs

@@ -1,0 +1,78 @@
+#!/usr/bin/env python3
+"""Runs the hostile suite (tests/hostile/test_*.py) and prints its summary:
+per defect item of the hardening issue, the tests that reproduce it and
+their figures; in all, faults survived, bad inputs tried, load held and
+anything lost. Exit 0 only when every test passed, every item 1-11 has a
+passing test and nothing was lost.
+
+    HMPM_BUILD_DIR=build python3 tests/hostile/run.py [-k PATTERN]
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import sys
+import tempfile
+import time
+import unittest
+from pathlib import Path
+
+HERE = Path(__file__).resolve().parent
+REPO = HERE.parents[1]
+ITEMS = range(1, 12)
+SUMMED = ("faults", "bad_inputs", "requests", "lost")
+
+
+class _Named(unittest.TextTestResult):
+    """Tells support.record() which test is running."""
+
+    def startTest(self, test):
+        os.environ["HMPM_HOSTILE_TEST"] = test.id().split(".", 2)[-1]
+        super().startTest(test)
+
+
+def main(argv) -> int:
+    sys.path.insert(0, str(REPO))
+    fd, figures = tempfile.mkstemp(prefix="hmpm-hostile-", suffix=".jsonl")
+    os.close(fd)
+    os.environ["HMPM_HOSTILE_FIGURES"] = figures
+    pattern = None
+    if len(argv) >= 2 and argv[0] == "-k":
+        pattern = argv[1]
+    loader = unittest.TestLoader()
+    if pattern:
+        loader.testNamePatterns = [f"*{pattern}*"]
+    suite = loader.discover(str(HERE), pattern="test_*.py", top_level_dir=str(REPO))
+    start = time.monotonic()
+    result = unittest.TextTestRunner(verbosity=2, resultclass=_Named).run(suite)
+    elapsed = time.monotonic() - start
+    rows = [json.loads(line) for line in Path(figures).read_text().splitlines() if line.strip()]
+    os.unlink(figures)
+
+    print(f"\nhostile suite: {result.testsRun} tests in {elapsed:.0f} s, "
+          f"{len(result.failures) + len(result.errors)} failed")
+    totals = {k: 0 for k in SUMMED}
+    missing = []
+    for item in ITEMS:
+        mine = [r for r in rows if r["item"] == item]
+        if not mine:
+            missing.append(item)
+            print(f"  item {item:2d}: NO PASSING TEST")
+            continue
+        for r in mine:
+            extra = {k: v for k, v in r.items() if k not in ("item", "test")}
+            for k in SUMMED:
+                totals[k] += int(extra.get(k, 0) or 0)
+            shown = ", ".join(f"{k}={v}" for k, v in extra.items())
+            print(f"  item {item:2d}: {r['test']}: {shown}")
+    print(f"  in all: faults survived {totals['faults']}, bad inputs tried {totals['bad_inputs']}, "
+          f"requests answered under load {totals['requests']}, lost {totals['lost']}")
+    ok = result.wasSuccessful() and totals["lost"] == 0 and (pattern is not None or not missing)
+    if missing and pattern is None:
+        print(f"  items without a passing test: {missing}")
+    return 0 if ok else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))
