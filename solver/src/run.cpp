@@ -11,6 +11,24 @@
 
 namespace hmpm {
 
+namespace {
+
+/// The compiled Simulation of the problem's dimension and shape function.
+template <int Dim>
+RunResult run_with_shape(const Problem& problem, const RunOptions& options) {
+  switch (problem.shape_function) {
+    case ShapeFunction::gimp:
+      return run_simulation<Dim, shape::Gimp>(problem, options);
+    case ShapeFunction::bspline:
+      return run_simulation<Dim, shape::BSpline>(problem, options);
+    case ShapeFunction::linear:
+      break;
+  }
+  return run_simulation<Dim, shape::Linear>(problem, options);
+}
+
+}  // namespace
+
 RunResult run(const Problem& problem, const RunOptions& options) {
   const std::vector<ProblemIssue> issues = check_problem(problem);
   if (!issues.empty()) {
@@ -22,11 +40,11 @@ RunResult run(const Problem& problem, const RunOptions& options) {
   }
   switch (problem.dimension) {
     case 1:
-      return run_dimension<1>(problem, options);
+      return run_with_shape<1>(problem, options);
     case 2:
-      return run_dimension<2>(problem, options);
+      return run_with_shape<2>(problem, options);
     default:
-      return run_dimension<3>(problem, options);
+      return run_with_shape<3>(problem, options);
   }
 }
 

@@ -1,7 +1,8 @@
-// run_dimension.hpp — the per-dimension entry points of the solver
-// (internal). run.cpp checks the Problem and calls the one of its
-// dimension; each is defined, with the Simulation explicitly instantiated
-// for its three shape functions, in simulation_{1,2,3}d.cpp.
+// run_dimension.hpp — the solver's compiled entry points (internal).
+// run.cpp checks the Problem and calls the run_simulation of its dimension
+// and shape function; they are defined, with the Simulation explicitly
+// instantiated, in simulation_instance.cpp, compiled once per dimension
+// (solver/CMakeLists.txt).
 #pragma once
 
 #include "hmpm/problem.hpp"
@@ -9,8 +10,14 @@
 
 namespace hmpm {
 
-/// Runs a checked Problem of dimension Dim (1, 2 or 3).
-template <int Dim>
-RunResult run_dimension(const Problem& problem, const RunOptions& options);
+namespace shape {
+struct Linear;
+struct Gimp;
+struct BSpline;
+}  // namespace shape
+
+/// Runs a checked Problem of dimension Dim (1, 2 or 3) with shape function Shape.
+template <int Dim, class Shape>
+RunResult run_simulation(const Problem& problem, const RunOptions& options);
 
 }  // namespace hmpm
