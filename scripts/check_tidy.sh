@@ -111,11 +111,27 @@ else
 fi
 out=$(mktemp -d)
 trap 'rm -rf "$out"' EXIT
+# The build's compile commands without its precompiled headers (CMake's
+# `-include .../cmake_pch.hxx`): clang cannot read GCC's .gch files, and the
+# headers they hold are included by the sources themselves.
+python3 - "$build/compile_commands.json" "$out/compile_commands.json" <<'PY'
+import json, re, sys
+entries = json.load(open(sys.argv[1]))
+for e in entries:
+    e["command"] = re.sub(r"\s-Winvalid-pch|\s-include\s+\S*cmake_pch\.hxx", "", e["command"])
+json.dump(entries, open(sys.argv[2], "w"))
+PY
 echo "check_tidy: ${#files[@]} files, $jobs jobs${base:+, changed since $base}" >&2
-export clang_tidy build out
+export clang_tidy out
 printf '%s\n' "${files[@]}" | xargs -P "$jobs" -I{} sh -c \
-  '"$clang_tidy" -p "$build" --quiet --extra-arg=-Wno-unknown-warning-option "$1" \
-     > "$out/$(echo "$1" | tr / _).log" 2>/dev/null || true' _ {}
+  '"$clang_tidy" -p "$out" --quiet --extra-arg=-Wno-unknown-warning-option "$1" \
+     > "$out/$(echo "$1" | tr / _).log" 2>&1 || true' _ {}
+# A unit clang-tidy could not process is a failure, not a clean file.
+if grep -l -E '^Error while processing|error: .*\[clang-diagnostic-error\]' "$out"/*.log >/dev/null 2>&1; then
+  grep -h -E '^Error while processing|\[clang-diagnostic-error\]' "$out"/*.log | sort -u | head -20 >&2
+  echo "check_tidy: clang-tidy could not process some files (above)" >&2
+  exit 1
+fi
 # One line per finding (file:line:col: warning: text [check]), relative paths,
 # each finding once even when several files include its header.
 { cat "$out"/*.log | grep -E '^/.*:[0-9]+:[0-9]+: (warning|error): ' || true; } |
