@@ -1,5 +1,5 @@
 // run.cpp — entry point: checks a Problem and dispatches to the solver of
-// its dimension (simulation_{1,2,3}d.cpp, each instantiated for the linear,
+// its dimension (simulation_instance.cpp, compiled per dimension for the linear,
 // GIMP and B-spline shape functions, so every hot loop is compiled for fixed
 // sizes).
 #include <stdexcept>

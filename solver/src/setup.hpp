@@ -1,5 +1,5 @@
 // setup.hpp — building a Simulation from a Problem (internal; included by
-// the simulation_{1,2,3}d.cpp instantiations): the grid, the material
+// the simulation_instance.cpp instantiations): the grid, the material
 // constants, the particles, the compiled constraints and loads, and the
 // geostatic initial state. Runs once per run; allocates, never per step.
 #pragma once

@@ -25,7 +25,7 @@
 // each: particle_to_grid, grid, grid_to_particle, stress_and_flux,
 // pore_pressure), failure reports in failures.hpp, output in output.hpp,
 // the time loop in time_loop.hpp. Explicitly instantiated per dimension in
-// simulation_{1,2,3}d.cpp, so every hot loop is compiled for fixed sizes
+// simulation_instance.cpp, so every hot loop is compiled for fixed sizes
 // and inlined within one translation unit. No phase allocates, calls a
 // virtual function or looks anything up by string.
 #pragma once

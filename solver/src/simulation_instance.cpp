@@ -17,7 +17,8 @@ template class Simulation<HMPM_DIM, shape::Gimp>;
 template class Simulation<HMPM_DIM, shape::BSpline>;
 
 template <>
-RunResult run_simulation<HMPM_DIM, shape::Linear>(const Problem& problem, const RunOptions& options) {
+RunResult run_simulation<HMPM_DIM, shape::Linear>(const Problem& problem,
+                                                  const RunOptions& options) {
   return Simulation<HMPM_DIM, shape::Linear>(problem).run(options);
 }
 template <>
@@ -25,7 +26,8 @@ RunResult run_simulation<HMPM_DIM, shape::Gimp>(const Problem& problem, const Ru
   return Simulation<HMPM_DIM, shape::Gimp>(problem).run(options);
 }
 template <>
-RunResult run_simulation<HMPM_DIM, shape::BSpline>(const Problem& problem, const RunOptions& options) {
+RunResult run_simulation<HMPM_DIM, shape::BSpline>(const Problem& problem,
+                                                   const RunOptions& options) {
   return Simulation<HMPM_DIM, shape::BSpline>(problem).run(options);
 }
 

@@ -9,8 +9,7 @@
 
 namespace hmpm::constitutive {
 
-double return_drucker_prager(Voigt& stress, const Elastic& el,
-                             const DruckerPragerConstants& dp) {
+double return_drucker_prager(Voigt& stress, const Elastic& el, const DruckerPragerConstants& dp) {
   const double p = (stress(0) + stress(1) + stress(2)) / 3.0;
   const double dx = stress(0) - p, dy = stress(1) - p, dz = stress(2) - p;
   const double q = std::sqrt(0.5 * (dx * dx + dy * dy + dz * dz) + stress(3) * stress(3) +

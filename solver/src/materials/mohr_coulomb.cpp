@@ -168,14 +168,13 @@ Eigen::Vector3d mohr_coulomb_principal(const Eigen::Vector3d& trial, const Elast
 
 namespace {
 
-
 /// d r / d t of the principal return onto the planes of `active` (ordered
 /// principal stresses, descending): with N and B the active planes' normals
 /// and flows and D the principal stiffness, r = t - D B A^-1 (N^T t - c),
 /// A = N^T D B, so dr/dt = I - D B A^-1 N^T; I when nothing was active, 0
 /// when the result is a fixed point (or three independent planes meet).
 Eigen::Matrix3d principal_return_jacobian(const ActiveSet& active, const Elastic& el,
-                                                 const MohrCoulombConstants& mc) {
+                                          const MohrCoulombConstants& mc) {
   if (active.fixed || active.count >= 3) return Eigen::Matrix3d::Zero();
   if (active.count == 0) return Eigen::Matrix3d::Identity();
   Eigen::Matrix<double, 3, 2> n = Eigen::Matrix<double, 3, 2>::Zero();
@@ -195,8 +194,7 @@ Eigen::Matrix3d principal_return_jacobian(const ActiveSet& active, const Elastic
 
 }  // namespace detail
 
-double return_mohr_coulomb(Voigt& stress, const Elastic& el,
-                                             const MohrCoulombConstants& mc) {
+double return_mohr_coulomb(Voigt& stress, const Elastic& el, const MohrCoulombConstants& mc) {
   // Cheap elastic test: with s the deviator, s1 - s3 <= 2 sqrt(J2),
   // s1 + s3 = 2p - s2 <= 2p + sqrt(J2/3) and s1 <= p + 2 sqrt(J2/3).
   const double p = (stress(0) + stress(1) + stress(2)) / 3.0;
