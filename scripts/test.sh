@@ -6,28 +6,39 @@
 # and python3-selenium, which install-deps.sh installs; about 25 s).
 set -euo pipefail
 cd "$(dirname "$0")/.."
-bash scripts/install-deps.sh
-bash scripts/build.sh
-jobs=$(nproc 2>/dev/null || echo 2)
+# Each stage is timed; a summary of stages, seconds and results ends the run.
+summary=()
 status=0
-bash scripts/check_format.sh || status=1
+stage() {
+  local name=$1 t0=$SECONDS rc=0
+  shift
+  echo "=== test.sh: $name" >&2
+  "$@" || rc=$?
+  summary+=("$(printf '%-14s %5d s  %s' "$name" $((SECONDS - t0)) "$([ $rc -eq 0 ] && echo ok || echo "FAILED ($rc)")")")
+  [ $rc -eq 0 ] || status=1
+}
+stage install-deps bash scripts/install-deps.sh
+stage build bash scripts/build.sh
+if [ $status -ne 0 ]; then printf '%s\n' "${summary[@]}" >&2; exit 1; fi
+jobs=$(nproc 2>/dev/null || echo 2)
+stage format bash scripts/check_format.sh
 # clang-tidy over the code changed since .ci/tidy-baseline, the last commit
 # on which every file was checked clean (a full run takes 7 min of the 15-min
 # budget); a baseline git does not know means a full run.
 # `bash scripts/check_tidy.sh` with no argument checks everything.
 tidy_base=$(cat .ci/tidy-baseline 2>/dev/null || true)
 if [ -n "$tidy_base" ] && git rev-parse --verify -q "$tidy_base^{commit}" >/dev/null 2>&1; then
-  bash scripts/check_tidy.sh "$tidy_base" || status=1
+  stage tidy bash scripts/check_tidy.sh "$tidy_base"
 else
-  bash scripts/check_tidy.sh || status=1
+  stage tidy bash scripts/check_tidy.sh
 fi
-(cd build && ctest --output-on-failure -j "$jobs" --timeout 600) || status=1
+stage ctest bash -c "cd build && ctest --output-on-failure -j $jobs --timeout 600"
 py=$(bash scripts/python.sh)
-if [ -d tests/python ] && ls tests/python/test_*.py >/dev/null 2>&1; then
-  HMPM_BUILD_DIR="$PWD/build" PYTHONPATH="$PWD/clients/python" \
-    "$py" -m unittest discover -s tests/python -t . -v || status=1
-fi
+stage python env HMPM_BUILD_DIR="$PWD/build" PYTHONPATH="$PWD/clients/python" \
+  "$py" -m unittest discover -s tests/python -t . -v
 # Selenium is Debian's python3-selenium: the system interpreter, not a venv.
-/usr/bin/python3 tests/browser/check_embed.py || status=1
-HMPM_BUILD_DIR="$PWD/build" /usr/bin/python3 tests/browser/test_dashboard.py || status=1
+stage browser-embed /usr/bin/python3 tests/browser/check_embed.py
+stage browser env HMPM_BUILD_DIR="$PWD/build" /usr/bin/python3 tests/browser/test_dashboard.py
+echo "=== test.sh: summary" >&2
+printf '%s\n' "${summary[@]}" >&2
 exit $status
