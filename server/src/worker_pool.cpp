@@ -159,17 +159,24 @@ bool WorkerPool::cancel(const std::string& id, double wait_s) {
   return true;
 }
 
-void WorkerPool::shutdown() {
-  std::vector<std::thread> threads;
+void WorkerPool::stop_claiming() {
   {
     std::lock_guard<std::mutex> lock(mutex_);
     stopping_ = true;
     for (auto& [id, running] : running_) running->cancel = true;
-    threads.swap(threads_);
-    if (heartbeat_.joinable()) threads.push_back(std::move(heartbeat_));
   }
   wake_.notify_all();
   heartbeat_wake_.notify_all();
+}
+
+void WorkerPool::shutdown() {
+  stop_claiming();
+  std::vector<std::thread> threads;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    threads.swap(threads_);
+    if (heartbeat_.joinable()) threads.push_back(std::move(heartbeat_));
+  }
   for (auto& t : threads) t.join();
 }
 

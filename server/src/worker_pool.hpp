@@ -60,8 +60,10 @@ class WorkerPool {
   /// to `wait_s` for the worker to let go of the job (its files recorded or
   /// removed). Returns whether a worker of this process was running it.
   bool cancel(const std::string& id, double wait_s = 0.0);
-  /// Stops taking jobs, cancels the running ones, puts them back in the
-  /// queue and joins the threads. Idempotent.
+  /// Stops taking jobs and asks the running ones to stop; each worker puts
+  /// its job back in the queue and ends. Returns at once. Idempotent.
+  void stop_claiming();
+  /// stop_claiming(), then joins the threads. Idempotent.
   void shutdown();
 
   /// Where the result files of job `id` live.

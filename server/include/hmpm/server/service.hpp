@@ -44,6 +44,10 @@ struct ServiceConfig {
   /// ended, at start-up and hourly; 0 keeps them forever (retention.hpp).
   int retain_days = 30;
   double retention_interval_s = 3600.0;  ///< how often run() purges
+  /// stop(): how long connections may finish their requests before their
+  /// sockets are shut down (a client trickling a request holds its thread
+  /// for ever otherwise).
+  double shutdown_drain_s = 5.0;
 };
 
 class Service {
@@ -59,12 +63,15 @@ class Service {
 
   /// Binds the listening socket; returns the port, or -1 if binding failed.
   int bind();
-  /// Starts the workers and serves until stop(); then cancels running jobs,
-  /// puts them back in the queue and joins every thread. Returns false if
+  /// Starts the workers and serves until stop(); then joins every thread
+  /// (the workers have put their jobs back in the queue). Returns false if
   /// serving could not start.
   bool run();
-  /// Thread-safe and idempotent: stop accepting, end event streams, make
-  /// run() return.
+  /// Thread-safe and idempotent: stop claiming jobs and cancel the running
+  /// ones (their workers put them back in the queue), stop accepting, end
+  /// event streams, give open connections shutdown_drain_s to finish, then
+  /// shut down the sockets of those left so run() returns. Returns once run()
+  /// has stopped serving, or about 2 s after the drain if it cannot.
   void stop();
   /// True once run() is accepting connections.
   bool is_running() const;
