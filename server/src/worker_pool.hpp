@@ -22,6 +22,7 @@
 #include <condition_variable>
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -82,6 +83,14 @@ class WorkerPool {
   // cancelled, removes them if it was deleted (the store decides).
   void end_dismissed(const JobRecord& job, const Claim& claim,
                      const std::vector<std::string>& written, double seconds);
+  // A write that ends a job's attempt (finish, requeue, keep_results): a
+  // StoreFailure (disk full, I/O error) is logged and the write retried after
+  // first_retry_s, doubling up to last_retry_s, until it succeeds or the pool
+  // stops (then the failure is rethrown and start-up recovery deals with it).
+  ClaimState with_retries(const std::string& id, const char* during,
+                          const std::function<ClaimState()>& write);
+  static constexpr double first_retry_s = 0.1;
+  static constexpr double last_retry_s = 5.0;
 
   JobStore& store_;
   Metrics& metrics_;
@@ -90,6 +99,7 @@ class WorkerPool {
   std::condition_variable wake_;            ///< workers: a job was queued, or stop
   std::condition_variable heartbeat_wake_;  ///< the heartbeat thread: stop
   std::condition_variable job_done_;        ///< a worker let go of a job
+  std::condition_variable retry_wake_;      ///< a worker retrying a store write: stop
   bool stopping_ = false;
   std::uint64_t generation_ = 0;  ///< bumped by notify()
   std::map<std::string, std::shared_ptr<Running>> running_;

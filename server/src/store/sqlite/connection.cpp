@@ -1,14 +1,39 @@
 // connection.cpp — see connection.hpp.
 #include "connection.hpp"
 
+#include <cerrno>
+#include <cstring>
 #include <utility>
 
 #include "hmpm/server/store.hpp"
 
 namespace hmpm::server::sqlite {
 
+namespace {
+
+// The operating system's error behind the last failure of `db`, 0 if it was
+// not an I/O failure (SQLite keeps the errno of its last failed system call).
+int system_error(sqlite3* db) {
+  const int code = db ? sqlite3_errcode(db) : SQLITE_NOMEM;
+  return code == SQLITE_IOERR || code == SQLITE_FULL || code == SQLITE_CANTOPEN
+             ? sqlite3_system_errno(db)
+             : 0;
+}
+
+// Whether the last failure of `db` was for want of space: SQLITE_FULL, or an
+// I/O error from a full disk, a quota or a file-size limit (RLIMIT_FSIZE).
+bool out_of_space(sqlite3* db) {
+  const int error = system_error(db);
+  return (db && sqlite3_errcode(db) == SQLITE_FULL) || error == ENOSPC || error == EFBIG ||
+         error == EDQUOT;
+}
+
+}  // namespace
+
 void fail(sqlite3* db, const std::string& what) {
-  throw StoreFailure(what + ": " + (db ? sqlite3_errmsg(db) : "out of memory"));
+  std::string message = what + ": " + (db ? sqlite3_errmsg(db) : "out of memory");
+  if (const int error = system_error(db)) message += std::string(" (") + std::strerror(error) + ")";
+  throw StoreFailure(message, out_of_space(db));
 }
 
 void exec(sqlite3* db, const char* sql) {
@@ -16,7 +41,7 @@ void exec(sqlite3* db, const char* sql) {
   if (sqlite3_exec(db, sql, nullptr, nullptr, &error) != SQLITE_OK) {
     const std::string message = error ? error : "unknown error";
     sqlite3_free(error);
-    throw StoreFailure(std::string("sqlite: ") + message);
+    throw StoreFailure(std::string("sqlite: ") + message, out_of_space(db));
   }
 }
 

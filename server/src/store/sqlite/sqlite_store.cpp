@@ -116,12 +116,56 @@ std::int64_t SqliteStore::lease_until(const Claimant& who) const {
   return now_ms() + static_cast<std::int64_t>(who.lease_s * 1000.0);
 }
 
+namespace {
+
+// What to do about a database file that cannot be used as it is.
+constexpr const char* damaged_advice =
+    "; restore it from a backup, or move it away to start with an empty queue (its jobs are "
+    "then lost)";
+
+// A file that exists but is empty would be taken by SQLite for a new
+// database: an emptied file (a failed copy, a full disk) must not become an
+// empty queue quietly.
+void refuse_empty_file(const std::filesystem::path& db_path) {
+  std::error_code ec;
+  if (std::filesystem::exists(db_path, ec) && std::filesystem::file_size(db_path, ec) == 0 && !ec)
+    throw StoreFailure("database " + db_path.string() +
+                       " is an empty file (0 bytes), not an hmpm database" + damaged_advice);
+}
+
+// PRAGMA quick_check over the whole file (every page, index and row
+// format; O(file size), a second or so per hundred MiB).
+void check_integrity(sqlite3* db, const std::filesystem::path& db_path) {
+  Statement s(db, "PRAGMA quick_check(5)");
+  std::string found;
+  while (s.step()) {
+    const std::string row = s.text(0);
+    if (row == "ok") continue;
+    found += (found.empty() ? "" : "; ") + row;
+  }
+  if (!found.empty())
+    throw StoreFailure("database " + db_path.string() + " is damaged (integrity check: " + found +
+                       ")" + damaged_advice);
+}
+
+}  // namespace
+
 SqliteStore::SqliteStore(const std::filesystem::path& db_path, WallClock clock)
     : clock_(std::move(clock)),
       lock_(ProcessLock::hold(lock_path_for(db_path), "database " + db_path.string())),
       pool_(db_path) {
-  auto connection = pool_.lease();
-  sqlite3* db = connection.get();
+  refuse_empty_file(db_path);
+  std::optional<Connection> connection;
+  try {
+    connection.emplace(pool_.lease());
+    check_integrity(connection->get(), db_path);
+  } catch (const StoreFailure& e) {
+    const std::string what = e.what();
+    if (what.rfind("database ", 0) == 0) throw;
+    throw StoreFailure("database " + db_path.string() + " cannot be opened (" + what + ")" +
+                       damaged_advice);
+  }
+  sqlite3* db = connection->get();
   migrate(db);
   // The lock is ours, so no other process is running anything: every
   // earlier claim is void and recover() may requeue its job.
@@ -132,8 +176,42 @@ SqliteStore::SqliteStore(const std::filesystem::path& db_path, WallClock clock)
 }
 
 void SqliteStore::probe() {
-  auto db = pool_.lease();
-  recorded_version(db.get());
+  auto connection = pool_.lease();
+  sqlite3* db = connection.get();
+  try {
+    recorded_version(db);
+  } catch (const StoreFailure& e) {
+    throw StoreFailure(std::string("the database cannot be read: ") + e.what(), e.no_space());
+  }
+  // The write: at most once a second (health checks may come far more
+  // often); in between, the last write's outcome stands.
+  const auto now = std::chrono::steady_clock::now();
+  {
+    std::lock_guard<std::mutex> lock(probe_mutex_);
+    if (now - last_write_probe_ < std::chrono::seconds(1)) {
+      if (!write_probe_error_.empty()) throw StoreFailure(write_probe_error_, write_probe_full_);
+      return;
+    }
+    last_write_probe_ = now;
+  }
+  std::string error;
+  bool full = false;
+  try {
+    WriteTransaction tx(db);
+    Statement s(db,
+                "INSERT INTO store_probe (id, written) VALUES (1, ?1) "
+                "ON CONFLICT (id) DO UPDATE SET written = excluded.written");
+    s.bind(1, now_text());
+    s.step();
+    tx.commit();
+  } catch (const StoreFailure& e) {
+    error = std::string("the database cannot be written: ") + e.what();
+    full = e.no_space();
+  }
+  std::lock_guard<std::mutex> lock(probe_mutex_);
+  write_probe_error_ = error;
+  write_probe_full_ = full;
+  if (!error.empty()) throw StoreFailure(error, full);
 }
 
 SubmitResult SqliteStore::submit(const NewJob& job, std::int64_t max_queue) {

@@ -8,8 +8,11 @@
 // earlier process are void and end as soon as the lock is ours.
 #pragma once
 
+#include <chrono>
 #include <filesystem>
+#include <mutex>
 #include <optional>
+#include <string>
 
 #include "connection.hpp"
 #include "hmpm/server/store.hpp"
@@ -51,6 +54,11 @@ class SqliteStore final : public JobStore {
   WallClock clock_;
   ProcessLock lock_;  ///< taken first, released last
   ConnectionPool pool_;
+  // probe(): when the last write probe ran and what it found ("" = written).
+  std::mutex probe_mutex_;
+  std::chrono::steady_clock::time_point last_write_probe_{};
+  std::string write_probe_error_;
+  bool write_probe_full_ = false;
 };
 
 /// The lock file of the database at `db_path`: `<db_path>.lock`.
