@@ -16,7 +16,7 @@ void get_health(Context& c, const httplib::Request&, httplib::Response& res) {
     res.set_header("Retry-After", std::to_string(store_retry_after_s));
     send_json(res, 503,
               Json{{"status", "unavailable"},
-                   {"detail", e.no_space() ? "the disk is full: the database cannot be written"
+                   {"detail", e.no_space() ? "no space left: the database cannot be written"
                                            : (unwritable ? "the database cannot be written"
                                                          : "the database cannot be read")}});
   } catch (const std::exception&) {

@@ -45,8 +45,8 @@ void send_store_failure(httplib::Response& res, bool no_space) {
   res.set_header("Retry-After", std::to_string(store_retry_after_s));
   if (no_space) {
     return send_problem(res, 507, "insufficient-storage", "Insufficient storage",
-                        "the server's disk is full: the database cannot be written; nothing was "
-                        "stored, retry later");
+                        "no space left for the database (disk full, quota or file-size limit): "
+                        "nothing was stored; retry later");
   }
   send_problem(res, 503, "store-unavailable", "Store unavailable",
                "the database cannot be written or read right now; nothing was stored, retry "

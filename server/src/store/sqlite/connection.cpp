@@ -1,8 +1,13 @@
 // connection.cpp — see connection.hpp.
 #include "connection.hpp"
 
+#include <sys/resource.h>
+
 #include <cerrno>
+#include <cstdint>
 #include <cstring>
+#include <filesystem>
+#include <string>
 #include <utility>
 
 #include "hmpm/server/store.hpp"
@@ -20,12 +25,32 @@ int system_error(sqlite3* db) {
              : 0;
 }
 
+// Whether a file of the database has reached the process's file-size limit
+// (RLIMIT_FSIZE), or its file system has less than 1 MiB left.
+bool files_at_their_limit(sqlite3* db) {
+  const char* name = sqlite3_db_filename(db, "main");
+  if (!name || !*name) return false;
+  const std::filesystem::path path(name);
+  std::error_code ec;
+  const auto space = std::filesystem::space(path.parent_path(), ec);
+  if (!ec && space.available < (std::uintmax_t{1} << 20)) return true;
+  rlimit limit{};
+  if (::getrlimit(RLIMIT_FSIZE, &limit) != 0 || limit.rlim_cur == RLIM_INFINITY) return false;
+  for (const std::string suffix : {"", "-wal", "-shm"}) {
+    const auto size = std::filesystem::file_size(path.string() + suffix, ec);
+    if (!ec && size >= limit.rlim_cur) return true;
+  }
+  return false;
+}
+
 // Whether the last failure of `db` was for want of space: SQLITE_FULL, or an
-// I/O error from a full disk, a quota or a file-size limit (RLIMIT_FSIZE).
+// I/O error from a full disk, a quota or a file-size limit. SQLite's errno
+// of an I/O error is not always the write's, so the files are looked at too.
 bool out_of_space(sqlite3* db) {
+  if (!db) return false;
   const int error = system_error(db);
-  return (db && sqlite3_errcode(db) == SQLITE_FULL) || error == ENOSPC || error == EFBIG ||
-         error == EDQUOT;
+  return sqlite3_errcode(db) == SQLITE_FULL || error == ENOSPC || error == EFBIG ||
+         error == EDQUOT || (sqlite3_errcode(db) == SQLITE_IOERR && files_at_their_limit(db));
 }
 
 }  // namespace
