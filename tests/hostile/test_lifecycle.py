@@ -17,9 +17,9 @@ import unittest
 from pathlib import Path
 from urllib.parse import urlparse
 
-from tests.hostile.jobs import KeptServer, log_events, submit, wait_status
-from tests.hostile.support import record
-from tests.python.support import long_spec
+from tests.hostile.jobs import KeptServer, log_events, request, submit, wait_status
+from tests.hostile.support import LiveServerCase, record
+from tests.python.support import bar_spec, long_spec
 
 # The issue's bound: SIGTERM ends the process within 10 s. The server gives
 # connections a 5 s drain (ServiceConfig::shutdown_drain_s), so 10 s leaves
@@ -117,6 +117,76 @@ class Sigterm(unittest.TestCase):
         record(item=3, faults=1, bad_inputs=1, requests=0, lost=0,
                exit_seconds=round(elapsed, 1), requeued=len(requeued),
                claimed_after_signal=len(starts) - len(running))
+
+
+
+def nan_between_samples(center: float) -> str:
+    """A formula that is NaN only for |t - center| < 1e-4: validation samples
+    [0, 0.5] every 0.5 ms (1001 instants), so with center = k * 0.5 ms +
+    0.15 ms no sample falls inside; the run's 10 us steps do."""
+    return f"1e-3*sqrt((t-{center})^2-1e-8)"
+
+
+class FormulasAndNames(LiveServerCase):
+    """Item 11 (b, c): NaN from a load formula at run time is reported as the
+    formula's; job names with control or bidirectional characters are
+    refused at submit."""
+
+    server_workers = 2
+
+    def test_nan_from_a_formula_names_the_formula(self):
+        traction = bar_spec(end=0.5, dt=1.0e-5)
+        traction["tractions"] = [{"particles": {"box": {"min": [0.9], "max": [1.0]}}, "face": "x+",
+                                  "traction": [nan_between_samples(0.10015)]}]
+        boundary = bar_spec(end=0.5, dt=1.0e-5)
+        boundary["boundaries"][0]["velocity"] = ["0*" + nan_between_samples(0.20015)]
+        cases = {"/tractions/0/traction/0": (traction, "0.10"),
+                 "/boundaries/0/velocity/0": (boundary, "0.20")}
+        for path, (spec, when) in cases.items():
+            with self.subTest(path=path):
+                job = submit(self.server.url, spec)
+                doc = wait_status(self.server.url, job, ("successful", "failed"), 60)
+                self.assertEqual(doc["status"], "failed", doc)
+                message = doc["message"]
+                self.assertIn(f"the formula at {path} gave NaN at t = {when}", message)
+                self.assertNotIn("volume", message)
+                self.assertNotIn("reduce time.dt", message)
+        # A formula that is NaN everywhere ("0/0", sqrt(-1)) never runs: 400 at submit.
+        refused = 0
+        for formula in ("0/0", "sqrt(-1)", "sqrt(t-1)"):
+            spec = bar_spec()
+            spec["tractions"] = [{"particles": {"box": {"min": [0.9], "max": [1.0]}},
+                                  "face": "x+", "traction": [formula]}]
+            code, _, body = request(self.server.url + "/jobs", "POST", json.dumps(spec).encode())
+            self.assertEqual(code, 400, body)
+            errors = json.loads(body)["errors"]
+            self.assertIn("/tractions/0/traction/0", [e["path"] for e in errors], errors)
+            refused += 1
+        record(item=11, faults=0, bad_inputs=len(cases) + refused, requests=len(cases) + refused,
+               lost=0, case="NaN from traction and boundary formulas")
+
+    def test_names_with_control_or_bidi_characters_refused(self):
+        names = {"nul": "a\u0000b", "newline": "run\nfake log line", "escape": "\u001b[31mred",
+                 "c1": "a\u0085b", "rlo": "invoice\u202efdp.exe", "isolate": "x\u2067y",
+                 "lrm": "a\u200eb", "alm": "a\u061cb"}
+        for what, name in names.items():
+            with self.subTest(name=what):
+                spec = bar_spec()
+                spec["name"] = name
+                code, _, body = request(self.server.url + "/jobs", "POST",
+                                        json.dumps(spec).encode())
+                self.assertEqual(code, 400, body)
+                errors = json.loads(body)["errors"]
+                self.assertEqual([e["path"] for e in errors], ["/name"], errors)
+                self.assertIn("remove it", errors[0]["message"])
+        # Letters of any script, punctuation and emoji stay allowed.
+        spec = bar_spec()
+        spec["name"] = "Böschung – Bemessung 斜面 🙂"
+        job = submit(self.server.url, spec)
+        doc = wait_status(self.server.url, job, ("successful", "failed"), 60)
+        self.assertEqual(doc["name"], spec["name"])
+        record(item=11, faults=0, bad_inputs=len(names), requests=len(names) + 1, lost=0,
+               case="job names with NUL, control and bidi characters")
 
 
 if __name__ == "__main__":
