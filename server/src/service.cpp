@@ -70,7 +70,7 @@ void log_recovery(const RecoveryReport& recovery) {
               {"job", id},
               {"status", status_name(JobStatus::failed)},
               {"recovered", true},
-              {"reason", "too many interrupted attempts"}});
+              {"reason", "interrupted too often (see its failure reason)"}});
   }
 }
 
@@ -87,7 +87,7 @@ struct Service::Impl {
         context{config, limits, *store, metrics, workers, stopping},
         auth(config.token),
         router(http::route_table(), context, auth) {
-    log_recovery(store->recover(config.max_attempts));
+    log_recovery(store->recover(config.max_attempts, config.charge_after_s));
     http::configure_server(server, context, router, auth);
   }
 

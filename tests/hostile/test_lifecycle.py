@@ -120,6 +120,46 @@ class Sigterm(unittest.TestCase):
 
 
 
+class UnrelatedCrashes(unittest.TestCase):
+    """Item 11 (a): jobs claimed just before crashes that are not theirs
+    (kill -9 about a second into their attempts) are not failed by the
+    attempt limit (3)."""
+
+    CRASHES = 4  # one more than --max-attempts
+
+    def setUp(self):
+        self.tmp = Path(tempfile.mkdtemp(prefix="hmpm-hostile-crash-"))
+        self.addCleanup(shutil.rmtree, self.tmp, True)
+
+    def test_innocent_jobs_survive_more_crashes_than_the_limit(self):
+        db = self.tmp / "db.sqlite"
+        server = KeptServer(db, workers=2).start()
+        self.addCleanup(server.stop)
+        heads = [submit(server.url, long_spec()) for _ in range(2)]
+        waiting = [submit(server.url, long_spec()) for _ in range(2)]
+        for crash in range(1, self.CRASHES + 1):
+            for job in heads:
+                doc = wait_status(server.url, job, "running", 20)
+                self.assertEqual(doc["attempts"], crash)
+            # Well under --charge-after (30 s): the attempts are too young to
+            # be the suspects of the crash.
+            time.sleep(1.0)
+            server.proc.kill()
+            server.proc.wait(10)
+            server.stop()
+            server = KeptServer(db, workers=2).start()
+            self.addCleanup(server.stop)
+        for job in heads:
+            doc = wait_status(server.url, job, ("running", "failed"), 20)
+            self.assertEqual(doc["status"], "running", doc)
+            self.assertEqual(doc["attempts"], self.CRASHES + 1)
+        for job in waiting:  # never started, never charged
+            doc = wait_status(server.url, job, "accepted", 5)
+            self.assertEqual(doc["attempts"], 0)
+        record(item=11, faults=self.CRASHES, bad_inputs=0, requests=0, lost=0,
+               case=f"{self.CRASHES} kill -9 one second into the attempts of 2 jobs: none failed")
+
+
 def nan_between_samples(center: float) -> str:
     """A formula that is NaN only for |t - center| < 1e-4: validation samples
     [0, 0.5] every 0.5 ms (1001 instants), so with center = k * 0.5 ms +

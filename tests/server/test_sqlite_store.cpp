@@ -148,7 +148,7 @@ TEST_F(SqliteStoreTest, UpgradesAVersionOneFileAndRecoversItsRunningJob) {
   std::string versions;  // every migration after the first ran
   for (const auto& m : sqlite::migrations) versions += std::to_string(m.version) + ";";
   EXPECT_EQ(query("SELECT version FROM schema_migrations ORDER BY version"), versions);
-  const auto report = store->recover(3);
+  const auto report = store->recover(3, 0.0);
   ASSERT_EQ(report.requeued.size(), 1u);
   EXPECT_EQ(store->find(report.requeued[0])->name, "old");
 }
@@ -185,10 +185,10 @@ TEST_F(SqliteStoreTest, LeasesOfAnEarlierProcessEndWhenTheLockIsOurs) {
     auto store = open_sqlite_store(db_path());
     id = store->submit(job("00000000-0000-4000-8000-000000000003"), 10).job.id;
     store->claim_next(Claimant{"earlier-process", 600.0});
-    EXPECT_TRUE(store->recover(3).requeued.empty());  // live while that store is open
+    EXPECT_TRUE(store->recover(3, 0.0).requeued.empty());  // live while that store is open
   }
   auto store = open_sqlite_store(db_path());
-  const auto report = store->recover(3);
+  const auto report = store->recover(3, 0.0);
   ASSERT_EQ(report.requeued.size(), 1u);
   EXPECT_EQ(report.requeued[0], id);
 }

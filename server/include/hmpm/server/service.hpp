@@ -30,7 +30,10 @@ struct ServiceConfig {
   std::string token;               ///< non-empty: Bearer token required (not on /health)
   long max_queue = 1000;           ///< accepted jobs before POST /jobs answers 503
   double job_wall_time_s = 0.0;    ///< per-job wall-clock limit; <= 0: none
-  int max_attempts = 3;            ///< starts of one job before restart recovery fails it
+  int max_attempts = 3;            ///< crashes charged to a job before recovery fails it
+  /// A crash is charged to a running job only when its attempt had run at
+  /// least this long (JobStore::recover).
+  double charge_after_s = 30.0;
   std::size_t max_body_bytes = std::size_t{16} << 20;  ///< request body limit (413)
   int max_event_streams = 8;           ///< concurrent GET /jobs/{id}/events (503 beyond)
   int http_threads = 24;               ///< connections served at once

@@ -123,6 +123,10 @@ struct SubmitResult {
   JobRecord job;
 };
 
+/// recover(): how many starts, in units of max_attempts, a job may have
+/// without a charged crash before it fails anyway.
+inline constexpr int uncharged_start_factor = 3;
+
 /// What start-up recovery did with jobs an earlier process left `running`.
 struct RecoveryReport {
   std::vector<std::string> requeued;
@@ -229,10 +233,17 @@ class JobStore {
 
   virtual std::vector<ResultFile> results(const std::string& id) = 0;
 
-  /// Recovery: every running job whose lease has lapsed goes back to
-  /// `accepted` while attempts < max_attempts, else to `failed` with the
-  /// reason. Jobs with a live lease are left alone, whoever owns them.
-  virtual RecoveryReport recover(int max_attempts) = 0;
+  /// Recovery: every running job whose lease has lapsed (its server died)
+  /// goes back to `accepted`, or to `failed` with the reason. The crash is
+  /// charged to the job only if its attempt had been running for at least
+  /// `charge_after_s` (claim to its last lease renewal or progress write):
+  /// a job claimed just before an unrelated crash is innocent. A job fails
+  /// once max_attempts crashes were charged to it, or, as a backstop against
+  /// a job that kills its server within charge_after_s of every start, once
+  /// it was started uncharged_start_factor * max_attempts times. Queued jobs
+  /// are never charged. Jobs with a live lease are left alone, whoever owns
+  /// them.
+  virtual RecoveryReport recover(int max_attempts, double charge_after_s) = 0;
 
   virtual StatusCounts count_by_status() = 0;
 

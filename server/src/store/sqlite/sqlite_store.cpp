@@ -7,6 +7,7 @@
 #include "sqlite_store.hpp"
 
 #include <chrono>
+#include <cstdio>
 #include <utility>
 
 #include "clock.hpp"
@@ -92,6 +93,13 @@ void insert_results(sqlite3* db, const std::string& id, const std::vector<Result
     s.bind(1, id).bind(2, f.name).bind(3, f.size).bind(4, f.sha256).bind(5, f.media_type);
     s.step();
   }
+}
+
+// "30 s", "1.5 s".
+std::string short_duration(double seconds) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%g s", seconds);
+  return text;
 }
 
 }  // namespace
@@ -305,8 +313,9 @@ std::optional<JobRecord> SqliteStore::claim_next(const Claimant& who) {
   Statement s(db, "UPDATE jobs SET status = " + sql_name(JobStatus::running) +
                       ", progress = 0, message = 'running', started = ?1, finished = NULL, "
                       "updated = ?1, attempts = attempts + 1, owner = ?3, "
-                      "lease_token = lease_token + 1, lease_expires_ms = ?4 WHERE id = ?2");
-  s.bind(1, now).bind(2, id).bind(3, who.instance).bind(4, lease_until(who));
+                      "lease_token = lease_token + 1, lease_expires_ms = ?4, claimed_ms = ?5, "
+                      "alive_ms = ?5 WHERE id = ?2");
+  s.bind(1, now).bind(2, id).bind(3, who.instance).bind(4, lease_until(who)).bind(5, now_ms());
   s.step();
   auto job = select_job(db, id);
   tx.commit();
@@ -317,9 +326,10 @@ std::int64_t SqliteStore::renew_leases(const Claimant& who) {
   auto connection = pool_.lease();
   sqlite3* db = connection.get();
   WriteTransaction tx(db);
-  Statement s(db, "UPDATE jobs SET lease_expires_ms = ?1 WHERE owner = ?2 AND status = " +
-                      sql_name(JobStatus::running));
-  s.bind(1, lease_until(who)).bind(2, who.instance);
+  Statement s(
+      db, "UPDATE jobs SET lease_expires_ms = ?1, alive_ms = ?3 WHERE owner = ?2 AND status = " +
+              sql_name(JobStatus::running));
+  s.bind(1, lease_until(who)).bind(2, who.instance).bind(3, now_ms());
   s.step();
   const std::int64_t renewed = sqlite3_changes(db);
   tx.commit();
@@ -330,9 +340,9 @@ ClaimState SqliteStore::update_progress(const Claim& claim, double percent) {
   auto connection = pool_.lease();
   sqlite3* db = connection.get();
   WriteTransaction tx(db);
-  Statement s(db, "UPDATE jobs SET progress = ?4, updated = ?5 WHERE " + claim_held);
+  Statement s(db, "UPDATE jobs SET progress = ?4, updated = ?5, alive_ms = ?6 WHERE " + claim_held);
   bind_claim(s, claim);
-  s.bind(4, percent).bind(5, now_text());
+  s.bind(4, percent).bind(5, now_text()).bind(6, now_ms());
   s.step();
   const ClaimState state = sqlite3_changes(db) == 1 ? ClaimState::held : claim_state(db, claim);
   tx.commit();
@@ -446,38 +456,60 @@ std::vector<ResultFile> SqliteStore::results(const std::string& id) {
   return out;
 }
 
-RecoveryReport SqliteStore::recover(int max_attempts) {
+RecoveryReport SqliteStore::recover(int max_attempts, double charge_after_s) {
   auto connection = pool_.lease();
   sqlite3* db = connection.get();
   WriteTransaction tx(db);
-  std::vector<std::pair<std::string, int>> lapsed;
+  struct Lapsed {
+    std::string id;
+    int attempts = 0;
+    int charged = 0;
+    double ran_s = 0.0;  ///< claim to last proof of life
+  };
+  std::vector<Lapsed> lapsed;
   {
-    Statement s(db, "SELECT id, attempts FROM jobs WHERE status = " + sql_name(JobStatus::running) +
-                        " AND lease_expires_ms <= ?1 ORDER BY seq");
+    Statement s(db,
+                "SELECT id, attempts, charged, alive_ms - claimed_ms FROM jobs WHERE status = " +
+                    sql_name(JobStatus::running) + " AND lease_expires_ms <= ?1 ORDER BY seq");
     s.bind(1, now_ms());
-    while (s.step()) lapsed.emplace_back(s.text(0), static_cast<int>(s.integer(1)));
+    while (s.step()) {
+      lapsed.push_back({s.text(0), static_cast<int>(s.integer(1)), static_cast<int>(s.integer(2)),
+                        static_cast<double>(s.integer(3)) / 1000.0});
+    }
   }
   RecoveryReport report;
   const std::string now = now_text();
-  for (const auto& [id, attempts] : lapsed) {
-    if (attempts < max_attempts) {
+  for (const Lapsed& job : lapsed) {
+    // Charged only when the attempt had run long enough to be the suspect;
+    // a job claimed just before an unrelated crash is not.
+    const int charged = job.charged + (job.ran_s >= charge_after_s ? 1 : 0);
+    std::string reason;
+    if (charged >= max_attempts) {
+      reason = "the server stopped " + std::to_string(charged) +
+               " times while this job ran (each time after at least " +
+               short_duration(charge_after_s) + " of its attempt; limit " +
+               std::to_string(max_attempts) + " attempts); not retried";
+    } else if (job.attempts >= uncharged_start_factor * max_attempts) {
+      reason = "this job was started " + std::to_string(job.attempts) +
+               " times and the server stopped every time, mostly within " +
+               short_duration(charge_after_s) + " of the start (limit " +
+               std::to_string(uncharged_start_factor * max_attempts) + " starts); not retried";
+    }
+    if (reason.empty()) {
       Statement s(db,
                   "UPDATE jobs SET status = " + sql_name(JobStatus::accepted) +
-                      ", progress = 0, started = NULL, updated = ?1, "
+                      ", progress = 0, started = NULL, updated = ?1, charged = ?3, "
                       "message = 'queued again: the server stopped while it ran' WHERE id = ?2");
-      s.bind(1, now).bind(2, id);
+      s.bind(1, now).bind(2, job.id).bind(3, static_cast<std::int64_t>(charged));
       s.step();
-      report.requeued.push_back(id);
+      report.requeued.push_back(job.id);
     } else {
-      const std::string reason = "the server stopped while this job ran, " +
-                                 std::to_string(attempts) + " times (limit " +
-                                 std::to_string(max_attempts) + " attempts); not retried";
       Statement s(db, "UPDATE jobs SET status = " + sql_name(JobStatus::failed) +
-                          ", message = ?1, failure_reason = ?1, finished = ?2, updated = ?2 "
-                          "WHERE id = ?3");
-      s.bind(1, reason).bind(2, now).bind(3, id);
+                          ", message = ?1, failure_reason = ?1, finished = ?2, updated = ?2, "
+                          "charged = ?4 WHERE id = ?3");
+      s.bind(1, reason).bind(2, now).bind(3, job.id).bind(4, static_cast<std::int64_t>(charged));
       s.step();
-      report.failed.push_back(id);
+      report.failed.push_back(job.id);
     }
   }
   tx.commit();

@@ -41,7 +41,7 @@ class SqliteStore final : public JobStore {
   ClaimState keep_results(const Claim& claim, const std::vector<ResultFile>& files,
                           double run_seconds) override;
   std::vector<ResultFile> results(const std::string& id) override;
-  RecoveryReport recover(int max_attempts) override;
+  RecoveryReport recover(int max_attempts, double charge_after_s) override;
   StatusCounts count_by_status() override;
   std::vector<std::string> purge_ended(std::chrono::system_clock::time_point ended_before) override;
 
