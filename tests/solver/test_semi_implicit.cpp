@@ -390,13 +390,33 @@ TEST(SemiImplicit, StableWhenDarcyDominates) {
 // saying what to change (here a load that turns NaN at t = 0.01 s: the
 // predicted velocity, hence the pressure system's right-hand side, is
 // non-finite, and the step reports it before solving or moving anything).
-TEST(SemiImplicit, NonFiniteStateFailsWithWhatToChange) {
+// A NaN load is reported as the formula's (the time loop checks load and
+// boundary values before each step), never as a diverged state.
+TEST(SemiImplicit, NaNLoadFailsNamingTheFormula) {
   Column c;
   c.cells = 20;
   hmpm::Problem p = terzaghi(c, 0.02);
   const double q = c.q;
   p.tractions[0].traction[c.axis] = [q](double t) {
     return t > 0.01 ? std::numeric_limits<double>::quiet_NaN() : -q;
+  };
+  const hmpm::RunResult r = hmpm::run(p);
+  ASSERT_EQ(r.status, hmpm::RunStatus::failed);
+  const std::string formula = "/tractions/0/traction/" + std::to_string(c.axis);
+  EXPECT_NE(r.message.find("the formula at " + formula + " gave NaN at t = 0.01"),
+            std::string::npos)
+      << r.message;
+  EXPECT_EQ(r.message.find("reduce time.dt"), std::string::npos) << r.message;
+}
+
+TEST(SemiImplicit, NonFiniteStateFailsWithWhatToChange) {
+  Column c;
+  c.cells = 20;
+  hmpm::Problem p = terzaghi(c, 0.02);
+  const double q = c.q;
+  // Finite, but so large that the state overflows.
+  p.tractions[0].traction[c.axis] = [q](double t) {
+    return t > 0.01 ? -std::numeric_limits<double>::max() : -q;
   };
   const hmpm::RunResult r = hmpm::run(p);
   ASSERT_EQ(r.status, hmpm::RunStatus::failed);
