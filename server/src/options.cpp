@@ -35,7 +35,8 @@ bool parse_seconds(const std::string& text, double& out) {
 std::string usage() {
   return "usage: hmpm-server [--host H] [--port P] --db PATH [--workers N] [--data-dir DIR]\n"
          "                   [--threads-per-job N] [--token T] [--max-queue N]\n"
-         "                   [--job-wall-time S] [--max-attempts N] [--max-body-bytes N]\n"
+         "                   [--job-wall-time S] [--max-attempts N] [--charge-after S]\n"
+         "                   [--max-body-bytes N]\n"
          "                   [--max-event-streams N] [--http-threads N] [--retain-days N]\n"
          "  --host H              address to listen on (default 127.0.0.1)\n"
          "  --port P              port; 0 picks a free one (default 8080)\n"
@@ -46,7 +47,9 @@ std::string usage() {
          "  --token T             require 'Authorization: Bearer T' (default: $HMPM_TOKEN)\n"
          "  --max-queue N         queued jobs before POST /jobs answers 503 (default 1000)\n"
          "  --job-wall-time S     fail a job running longer than S seconds (default: none)\n"
-         "  --max-attempts N      starts of a job before restart recovery fails it (default 3)\n"
+         "  --max-attempts N      crashes charged to a job before recovery fails it (default 3)\n"
+         "  --charge-after S      a crash is charged to a running job only if its attempt ran\n"
+         "                        at least S seconds (default 30)\n"
          "  --max-body-bytes N    request body limit, 413 beyond (default 16777216)\n"
          "  --max-event-streams N concurrent event streams, 503 beyond (default 8)\n"
          "  --http-threads N      connections served at once (default 24)\n"
@@ -106,6 +109,11 @@ ParsedOptions parse_options(const std::vector<std::string>& args, const char* en
        }},
       {"--max-attempts",
        integer(1, 1000, [&](long n) { config.max_attempts = static_cast<int>(n); })},
+      {"--charge-after",
+       [&](const std::string& v) {
+         return parse_seconds(v, config.charge_after_s) ? std::string()
+                                                        : std::string("must be seconds >= 0");
+       }},
       {"--max-body-bytes",
        integer(1024, long{1} << 40,
                [&](long n) { config.max_body_bytes = static_cast<std::size_t>(n); })},

@@ -14,6 +14,7 @@
 #include "digest.hpp"
 #include "hmpm/server/service.hpp"
 #include "hmpm/server/store.hpp"
+#include "http/drain.hpp"
 #include "http/server_setup.hpp"
 #include "job_log.hpp"
 #include "metrics.hpp"
@@ -69,7 +70,7 @@ void log_recovery(const RecoveryReport& recovery) {
               {"job", id},
               {"status", status_name(JobStatus::failed)},
               {"recovered", true},
-              {"reason", "too many interrupted attempts"}});
+              {"reason", "interrupted too often (see its failure reason)"}});
   }
 }
 
@@ -86,7 +87,7 @@ struct Service::Impl {
         context{config, limits, *store, metrics, workers, stopping},
         auth(config.token),
         router(http::route_table(), context, auth) {
-    log_recovery(store->recover(config.max_attempts));
+    log_recovery(store->recover(config.max_attempts, config.charge_after_s));
     http::configure_server(server, context, router, auth);
   }
 
@@ -105,6 +106,17 @@ struct Service::Impl {
   int port = -1;
   std::atomic<bool> run_started{false};
   std::atomic<bool> run_finished{false};
+  // Set when listen_after_bind() has returned (every connection thread ended).
+  std::mutex serve_mutex;
+  std::condition_variable serve_ended;
+  bool serving_done = false;
+
+  // Waits up to `seconds` for listen_after_bind() to return.
+  bool wait_serving_done(double seconds) {
+    std::unique_lock<std::mutex> lock(serve_mutex);
+    return serve_ended.wait_for(lock, std::chrono::duration<double>(seconds),
+                                [&] { return serving_done; });
+  }
   // The retention thread: purges at start and every retention_interval_s
   // until run() ends.
   std::mutex retention_mutex;
@@ -167,6 +179,11 @@ bool Service::run() {
   std::thread retention;
   if (s.config.retain_days > 0) retention = std::thread([&s] { s.retention_loop(); });
   const bool ok = s.stopping || s.server.listen_after_bind();
+  {
+    std::lock_guard<std::mutex> lock(s.serve_mutex);
+    s.serving_done = true;
+  }
+  s.serve_ended.notify_all();
   if (retention.joinable()) {
     {
       std::lock_guard<std::mutex> lock(s.retention_mutex);
@@ -183,7 +200,10 @@ bool Service::run() {
 
 void Service::stop() {
   Impl& s = *impl_;
-  s.stopping = true;
+  const bool first = !s.stopping.exchange(true);
+  // No job is claimed from here on; running ones are cancelled and their
+  // workers requeue them while the connections drain.
+  s.workers.stop_claiming();
   // stop() may race with run() starting to listen: give it a moment to be
   // listening, so the listener it is about to open is closed too.
   const auto until = SteadyClock::now() + std::chrono::seconds(2);
@@ -191,6 +211,15 @@ void Service::stop() {
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
   }
   s.server.stop();
+  if (!first || !s.run_started) return;
+  if (s.wait_serving_done(s.config.shutdown_drain_s)) return;
+  // A connection still open after the drain (a client trickling its request,
+  // or one that does not read): shut its socket down so its thread ends.
+  const int cut = http::shut_down_connections(s.port);
+  log_line(
+      {{"event", "drain"}, {"seconds", s.config.shutdown_drain_s}, {"connections_shut_down", cut}});
+  if (!s.wait_serving_done(2.0))
+    log_line({{"event", "drain"}, {"detail", "connection threads still busy after 2 s"}});
 }
 
 std::vector<std::string> Service::purge_expired(std::chrono::system_clock::time_point now) {

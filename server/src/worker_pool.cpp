@@ -57,6 +57,20 @@ void remove_all_but_log(const std::filesystem::path& dir) {
   }
 }
 
+// Removes every file of `dir` that is neither the job's log nor one of
+// `listed` (the manifest): nothing stays in a job's folder that its manifest
+// does not show (the leftovers of a failed write hold space and are invisible).
+void remove_unlisted(const std::filesystem::path& dir, const std::vector<ResultFile>& listed) {
+  std::error_code ec;
+  for (const auto& entry : std::filesystem::directory_iterator(dir, ec)) {
+    const std::string name = entry.path().filename().string();
+    const bool kept =
+        name == run_log_name || std::any_of(listed.begin(), listed.end(),
+                                            [&](const ResultFile& f) { return f.name == name; });
+    if (!kept) std::filesystem::remove_all(entry.path(), ec);
+  }
+}
+
 // Size, SHA-256 and media type of each of `names` in `dir`, appended to
 // `files`; the name of the first one that cannot be read back, if any.
 std::optional<std::string> record_files(const std::filesystem::path& dir,
@@ -86,8 +100,9 @@ void WorkerPool::end_dismissed(const JobRecord& job, const Claim& claim,
   record_files(dir, written, files);
   ClaimState state = ClaimState::lost;
   try {
-    state = store_.keep_results(claim, files, seconds);
-  } catch (const std::exception& e) {
+    state = with_retries(job.id, "keep_results",
+                         [&] { return store_.keep_results(claim, files, seconds); });
+  } catch (const std::exception& e) {  // shutting down: the next start recovers the job
     log_line({{"event", "store_error"}, {"job", job.id}, {"detail", e.what()}});
   }
   if (state == ClaimState::lost) {  // not ours any more: touch nothing
@@ -159,17 +174,46 @@ bool WorkerPool::cancel(const std::string& id, double wait_s) {
   return true;
 }
 
-void WorkerPool::shutdown() {
-  std::vector<std::thread> threads;
+void WorkerPool::stop_claiming() {
   {
     std::lock_guard<std::mutex> lock(mutex_);
     stopping_ = true;
     for (auto& [id, running] : running_) running->cancel = true;
-    threads.swap(threads_);
-    if (heartbeat_.joinable()) threads.push_back(std::move(heartbeat_));
   }
   wake_.notify_all();
   heartbeat_wake_.notify_all();
+  retry_wake_.notify_all();
+}
+
+ClaimState WorkerPool::with_retries(const std::string& id, const char* during,
+                                    const std::function<ClaimState()>& write) {
+  double wait_s = first_retry_s;
+  for (int attempt = 1;; ++attempt) {
+    try {
+      return write();
+    } catch (const StoreFailure& e) {
+      std::unique_lock<std::mutex> lock(mutex_);
+      log_line({{"event", "store_error"},
+                {"job", id},
+                {"during", during},
+                {"attempt", attempt},
+                {"detail", e.what()},
+                {"retry_in_s", stopping_ ? 0.0 : wait_s}});
+      if (stopping_) throw;  // the job stays running; recovery at the next start requeues it
+      retry_wake_.wait_for(lock, std::chrono::duration<double>(wait_s), [&] { return stopping_; });
+      wait_s = std::min(2 * wait_s, last_retry_s);
+    }
+  }
+}
+
+void WorkerPool::shutdown() {
+  stop_claiming();
+  std::vector<std::thread> threads;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    threads.swap(threads_);
+    if (heartbeat_.joinable()) threads.push_back(std::move(heartbeat_));
+  }
   for (auto& t : threads) t.join();
 }
 
@@ -305,7 +349,7 @@ void WorkerPool::run_one(const JobRecord& job, Running& running) {
     return;
   }
   if (running.cancel && outcome != JobStatus::successful) {  // shutdown: run it again next start
-    const ClaimState state = store_.requeue(claim);
+    const ClaimState state = with_retries(job.id, "requeue", [&] { return store_.requeue(claim); });
     if (state == ClaimState::dismissed) return end_dismissed(job, claim, result.files, seconds);
     if (state == ClaimState::lost) {
       log_line({{"event", "job"}, {"job", job.id}, {"claim", "lost"}, {"seconds", seconds}});
@@ -323,8 +367,13 @@ void WorkerPool::run_one(const JobRecord& job, Running& running) {
     outcome = JobStatus::failed;
     reason = "result file " + *unreadable + " could not be read back";
   }
+  remove_unlisted(dir, files);
   const std::string message = outcome == JobStatus::successful ? "finished" : reason;
-  const ClaimState state = store_.finish(claim, JobEnd{outcome, message, reason, files, seconds});
+  // The end of a job must reach the store, or it would stay running until a
+  // restart: a failing write (disk full) is retried with backoff.
+  const ClaimState state = with_retries(job.id, "finish", [&] {
+    return store_.finish(claim, JobEnd{outcome, message, reason, files, seconds});
+  });
   if (state == ClaimState::lost) {  // taken over while finishing: the files are not ours
     log_line({{"event", "job"}, {"job", job.id}, {"claim", "lost"}, {"seconds", seconds}});
     return;

@@ -218,6 +218,9 @@ class Simulation {
   void fail_nonfinite(std::size_t p, const char* what);
   void fail_left_grid(std::size_t p);
   void fail_volume(std::size_t p, double j);
+  /// False (and a failure of the run naming the formula's place in the
+  /// spec) when a traction or boundary value is not finite at time t.
+  bool loads_finite_at(double t);
   static std::string number(double v);
 
   // ------------------------------------------------------------ output (output.hpp)

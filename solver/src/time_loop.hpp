@@ -137,7 +137,11 @@ RunResult Simulation<Dim, Shape>::run(const RunOptions& options) {
       t_new = t + h >= end - 0.01 * h ? end : t + h;
       if (n + 1 >= total) total = n + 2;
     }
-    time_scheme.step(t, t_new - t);
+    // Load and boundary formulas are checked at the step's end time before
+    // the step uses them (the start's was checked by the step before, or
+    // below for t = 0): a NaN there is reported as the formula's, not as the
+    // divergence it would cause.
+    if ((n > 0 || loads_finite_at(t)) && loads_finite_at(t_new)) time_scheme.step(t, t_new - t);
     if (failed_) {
       std::ostringstream where;
       if (failure_particle_ >= 0) {  // -1: a failure of the run, not of a particle

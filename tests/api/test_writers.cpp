@@ -209,17 +209,25 @@ TEST(RunJob, WritesEveryRequestedFileAndASummary) {
   EXPECT_NE(std::find(out.files.begin(), out.files.end(), "snapshots.pvd"), out.files.end());
 }
 
-TEST(RunJob, FailedWriteStillLeavesASummaryAndThrows) {
+TEST(RunJob, FailedWriteLeavesOnlyASummaryAndSaysWhy) {
   const ParseResult parsed =
       parse_job(testing::read_text(testing::source_path("examples/bar-vibration.json")));
   ASSERT_TRUE(parsed.job);
   testing::TempDir dir;
-  // A directory where the first snapshot file should go makes its rename fail.
-  fs::create_directories(dir.path() / "snapshot_0000.vtu" / "blocker");
-  EXPECT_THROW(run_job(*parsed.job, dir.path()), std::runtime_error);
+  // A directory where the second snapshot file should go makes its rename
+  // fail after the first snapshot and the .pvd were written.
+  fs::create_directories(dir.path() / "snapshot_0001.vtu" / "blocker");
+  const JobOutcome out = run_job(*parsed.job, dir.path());
+  EXPECT_NE(out.write_error.find("snapshot_0001"), std::string::npos) << out.write_error;
+  EXPECT_EQ(out.run.status, RunStatus::failed);
+  EXPECT_EQ(out.files, std::vector<std::string>{"summary.json"});
+  // The snapshot and collection written before the failure are gone.
+  EXPECT_FALSE(fs::exists(dir.path() / "snapshot_0000.vtu"));
+  EXPECT_FALSE(fs::exists(dir.path() / "snapshots.pvd"));
   const json summary = json::parse(testing::read_text(dir.path() / "summary.json"));
   EXPECT_EQ(summary["status"], "failed");
   EXPECT_NE(summary["message"].get<std::string>().find("could not write"), std::string::npos);
+  EXPECT_NE(summary["message"].get<std::string>().find("removed"), std::string::npos);
 }
 
 }  // namespace

@@ -212,7 +212,7 @@ TEST_P(StoreContract, QueueCapCountsOnlyWaitingJobs) {
 TEST_P(StoreContract, RecoveryDoesNotRequeueAJobWhoseLeaseIsLive) {
   const auto id = store().submit(job("owned"), 10).job.id;
   const auto claimed = store().claim_next(live());
-  const auto report = store().recover(3);
+  const auto report = store().recover(3, 0.0);
   EXPECT_TRUE(report.requeued.empty());
   EXPECT_TRUE(report.failed.empty());
   const auto job = store().find(id);
@@ -227,7 +227,7 @@ TEST_P(StoreContract, RenewedLeasesStayLiveAndOnlyTheOwnersAreRenewed) {
   store().claim_next(dead("me"));
   store().claim_next(dead("them"));
   EXPECT_EQ(store().renew_leases(Claimant{"me", 600.0}), 1);
-  const auto report = store().recover(3);
+  const auto report = store().recover(3, 0.0);
   ASSERT_EQ(report.requeued.size(), 1u);
   EXPECT_EQ(report.requeued[0], theirs);
   EXPECT_EQ(store().find(mine)->status, JobStatus::running);
@@ -237,7 +237,7 @@ TEST_P(StoreContract, RenewedLeasesStayLiveAndOnlyTheOwnersAreRenewed) {
 TEST_P(StoreContract, ATakenOverJobRefusesTheWritesOfItsEarlierClaim) {
   const auto id = store().submit(job("taken-over"), 10).job.id;
   const Claim stale = claim_of(*store().claim_next(dead("paused")));
-  ASSERT_EQ(store().recover(3).requeued.size(), 1u);
+  ASSERT_EQ(store().recover(3, 0.0).requeued.size(), 1u);
   const Claim current = claim_of(*store().claim_next(live()));
   EXPECT_GT(current.token, stale.token);
   EXPECT_EQ(store().update_progress(stale, 99), ClaimState::lost);
@@ -250,11 +250,54 @@ TEST_P(StoreContract, ATakenOverJobRefusesTheWritesOfItsEarlierClaim) {
             ClaimState::held);
 }
 
+// The attempt limit counts only crashes that can be the job's: an attempt
+// that had run at least charge_after_s (claim to its last renewal or
+// progress write) is charged; one claimed just before an unrelated crash is
+// not, however often that happens, until the backstop of
+// uncharged_start_factor * max_attempts starts.
+TEST_P(StoreContract, RecoveryChargesACrashOnlyToAnAttemptThatRanLongEnough) {
+  const std::string innocent = store().submit(job("innocent"), 10).job.id;
+  const int backstop = uncharged_start_factor * 3;
+  for (int start = 1; start < backstop; ++start) {
+    const auto claimed = store().claim_next(dead());
+    ASSERT_TRUE(claimed);
+    ASSERT_EQ(claimed->id, innocent);
+    advance(std::chrono::seconds(5));
+    EXPECT_EQ(store().update_progress(claim_of(*claimed), 1), ClaimState::held);  // alive at 5 s
+    advance(std::chrono::seconds(60));  // ... and dies there, 5 s into the attempt
+    const auto report = store().recover(3, 30.0);
+    ASSERT_EQ(report.requeued.size(), 1u) << "start " << start;
+  }
+  // The backstop: started backstop times, each crash within 30 s.
+  ASSERT_TRUE(store().claim_next(dead()));
+  advance(std::chrono::seconds(60));
+  const auto stopped = store().recover(3, 30.0);
+  ASSERT_EQ(stopped.failed.size(), 1u);
+  EXPECT_NE(store().find(innocent)->failure_reason.find(std::to_string(backstop) + " times"),
+            std::string::npos)
+      << store().find(innocent)->failure_reason;
+
+  // A job whose attempts ran 40 s before each crash is charged every time.
+  const std::string suspect = store().submit(job("suspect"), 10).job.id;
+  for (int crash = 1; crash <= 3; ++crash) {
+    const auto claimed = store().claim_next(dead());
+    ASSERT_TRUE(claimed);
+    ASSERT_EQ(claimed->id, suspect);
+    advance(std::chrono::seconds(40));
+    store().update_progress(claim_of(*claimed), 50);
+    advance(std::chrono::seconds(60));
+    const auto report = store().recover(3, 30.0);
+    EXPECT_EQ(report.failed.size(), crash == 3 ? 1u : 0u) << "crash " << crash;
+  }
+  EXPECT_EQ(store().find(suspect)->status, JobStatus::failed);
+  EXPECT_NE(store().find(suspect)->failure_reason.find("3 times"), std::string::npos);
+}
+
 TEST_P(StoreContract, RecoveryRequeuesLapsedJobsUntilTheAttemptLimit) {
   const std::string id = store().submit(job("crashy"), 10).job.id;
   store().submit(job("waiting"), 10);
   for (int attempt = 1; attempt <= 3; ++attempt) {
-    const auto report = store().recover(3);  // a new process starts
+    const auto report = store().recover(3, 0.0);  // a new process starts
     if (attempt > 1) {
       ASSERT_EQ(report.requeued.size(), 1u);
       EXPECT_EQ(report.requeued[0], id);
@@ -265,7 +308,7 @@ TEST_P(StoreContract, RecoveryRequeuesLapsedJobsUntilTheAttemptLimit) {
     EXPECT_EQ(claimed->attempts, attempt);
     // ... and the process dies here, leaving the job running with its lease lapsing.
   }
-  const auto report = store().recover(3);
+  const auto report = store().recover(3, 0.0);
   EXPECT_TRUE(report.requeued.empty());
   ASSERT_EQ(report.failed.size(), 1u);
   const auto failed = store().find(id);

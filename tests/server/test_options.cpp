@@ -33,20 +33,15 @@ TEST(Options, RetainDaysZeroKeepsForeverAndNegativeIsRefused) {
 }
 
 TEST(Options, EveryFlagIsRead) {
-  const auto parsed = parse_options({"--host",   "0.0.0.0",
-                                     "--port=0", "--db",
-                                     "d.sqlite", "--workers",
-                                     "3",        "--data-dir",
-                                     "res",      "--threads-per-job",
-                                     "2",        "--token",
-                                     "t",        "--max-queue",
-                                     "5",        "--job-wall-time",
-                                     "1.5",      "--max-attempts",
-                                     "4",        "--max-body-bytes",
-                                     "4096",     "--max-event-streams",
-                                     "2",        "--http-threads",
-                                     "6"},
-                                    "env-token");
+  const auto parsed =
+      parse_options({"--host",   "0.0.0.0",           "--port=0", "--db",
+                     "d.sqlite", "--workers",         "3",        "--data-dir",
+                     "res",      "--threads-per-job", "2",        "--token",
+                     "t",        "--max-queue",       "5",        "--job-wall-time",
+                     "1.5",      "--max-attempts",    "4",        "--charge-after",
+                     "12.5",     "--max-body-bytes",  "4096",     "--max-event-streams",
+                     "2",        "--http-threads",    "6"},
+                    "env-token");
   ASSERT_TRUE(parsed.config) << parsed.error;
   const ServiceConfig& c = *parsed.config;
   EXPECT_EQ(c.host, "0.0.0.0");
@@ -58,6 +53,7 @@ TEST(Options, EveryFlagIsRead) {
   EXPECT_EQ(c.max_queue, 5);
   EXPECT_DOUBLE_EQ(c.job_wall_time_s, 1.5);
   EXPECT_EQ(c.max_attempts, 4);
+  EXPECT_DOUBLE_EQ(c.charge_after_s, 12.5);
   EXPECT_EQ(c.max_body_bytes, 4096u);
   EXPECT_EQ(c.max_event_streams, 2);
   EXPECT_EQ(c.http_threads, 6);

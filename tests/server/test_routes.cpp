@@ -469,14 +469,17 @@ TEST_F(RoutesTest, EventStreamsSendHeartbeatsWhenNothingChanges) {
   EXPECT_EQ(client_->Delete(("/jobs/" + busy).c_str())->status, 200);
 }
 
-TEST_F(RoutesTest, StoreFailuresAre500WithoutInternalText) {
+// A failing store is the server's trouble, not a bug: 503 store-unavailable
+// with Retry-After (507 when for want of space), and no internal text.
+TEST_F(RoutesTest, StoreFailuresAre503WithRetryAfterWithoutInternalText) {
   start();
   sqlite3* db = nullptr;
   ASSERT_EQ(sqlite3_open((dir_ / "db" / "hmpm.sqlite").c_str(), &db), SQLITE_OK);
   sqlite3_exec(db, "DROP TABLE results; DROP TABLE jobs;", nullptr, nullptr, nullptr);
   sqlite3_close(db);
   auto res = client_->Get("/jobs");
-  expect_problem(res, 500, "internal-error");
+  expect_problem(res, 503, "store-unavailable");
+  EXPECT_EQ(res->get_header_value("Retry-After"), "10");
   EXPECT_EQ(res->body.find("no such table"), std::string::npos) << res->body;
   for (const auto& [name, value] : res->headers) {
     EXPECT_EQ(value.find("no such table"), std::string::npos) << name << ": " << value;

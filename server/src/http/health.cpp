@@ -4,11 +4,23 @@
 
 namespace hmpm::server::http {
 
+// Ready means the database can be read and written (the store's probe);
+// the answer names which failed but not the server's paths (no token here).
 void get_health(Context& c, const httplib::Request&, httplib::Response& res) {
   try {
     c.store.probe();
     send_json(res, 200, Json{{"status", "ok"}});
+  } catch (const StoreFailure& e) {
+    const std::string what = e.what();
+    const bool unwritable = what.find("cannot be written") != std::string::npos;
+    res.set_header("Retry-After", std::to_string(store_retry_after_s));
+    send_json(res, 503,
+              Json{{"status", "unavailable"},
+                   {"detail", e.no_space() ? "no space left: the database cannot be written"
+                                           : (unwritable ? "the database cannot be written"
+                                                         : "the database cannot be read")}});
   } catch (const std::exception&) {
+    res.set_header("Retry-After", std::to_string(store_retry_after_s));
     send_json(res, 503, Json{{"status", "unavailable"}, {"detail", "the database cannot be read"}});
   }
 }

@@ -5,6 +5,7 @@
 
 #include <charconv>
 #include <chrono>
+#include <optional>
 
 #include "job_log.hpp"
 #include "problem.hpp"
@@ -97,20 +98,28 @@ void configure_server(httplib::Server& http, Context& context, const Router& rou
         return httplib::Server::HandlerResponse::Handled;
       }));
 
-  http.set_exception_handler([](const httplib::Request& req, httplib::Response& res,
-                                std::exception_ptr ep) {
-    std::string what = "unknown exception";
-    try {
-      std::rethrow_exception(std::move(ep));
-    } catch (const std::exception& e) {
-      what = e.what();
-    } catch (...) {
-    }
-    log_line({{"event", "error"}, {"method", req.method}, {"path", req.path}, {"detail", what}});
-    res = httplib::Response();
-    send_problem(res, 500, "internal-error", "Internal server error",
-                 "the server could not complete the request; its log has the details");
-  });
+  http.set_exception_handler(
+      [](const httplib::Request& req, httplib::Response& res, std::exception_ptr ep) {
+        std::string what = "unknown exception";
+        std::optional<bool> store_no_space;  // set: the store failed (503/507, not a bug)
+        try {
+          std::rethrow_exception(std::move(ep));
+        } catch (const StoreFailure& e) {
+          what = e.what();
+          store_no_space = e.no_space();
+        } catch (const std::exception& e) {
+          what = e.what();
+        } catch (...) {
+        }
+        log_line({{"event", store_no_space ? "store_error" : "error"},
+                  {"method", req.method},
+                  {"path", req.path},
+                  {"detail", what}});
+        res = httplib::Response();
+        if (store_no_space) return send_store_failure(res, *store_no_space);
+        send_problem(res, 500, "internal-error", "Internal server error",
+                     "the server could not complete the request; its log has the details");
+      });
 
   http.set_logger([&context](const httplib::Request& req, const httplib::Response& res) {
     context.metrics.count_request(res.status);

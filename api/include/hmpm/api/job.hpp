@@ -112,12 +112,19 @@ ParseResult parse_job(std::string_view json_text, const Limits& limits = {});
 struct JobOutcome {
   hmpm::RunResult run;
   std::vector<std::string> files;  ///< names relative to the output directory
+  /// Why a result file could not be written (disk full, ...); empty if all were.
+  std::string write_error;
 };
 
 /// Runs `job` and writes every result file into `out_dir` (created if needed):
 /// summary.json always (also on failure), series.json and series.csv when a
 /// series was requested, snapshots.pvd and snapshot_NNNN.vtu when snapshots
-/// were requested. Throws std::runtime_error only when files cannot be written.
+/// were requested. When a file cannot be written, the run fails
+/// (`write_error`, run.status failed), every other result file it wrote is
+/// removed (a full disk is not left fuller, and no file is left that the
+/// list does not name) and summary.json says why; `files` then lists
+/// summary.json alone, or nothing if even that could not be written. Throws
+/// std::runtime_error only when `out_dir` cannot be created.
 JobOutcome run_job(const ParsedJob& job, const std::filesystem::path& out_dir,
                    const hmpm::RunOptions& options = {});
 

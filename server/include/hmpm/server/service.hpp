@@ -30,7 +30,10 @@ struct ServiceConfig {
   std::string token;               ///< non-empty: Bearer token required (not on /health)
   long max_queue = 1000;           ///< accepted jobs before POST /jobs answers 503
   double job_wall_time_s = 0.0;    ///< per-job wall-clock limit; <= 0: none
-  int max_attempts = 3;            ///< starts of one job before restart recovery fails it
+  int max_attempts = 3;            ///< crashes charged to a job before recovery fails it
+  /// A crash is charged to a running job only when its attempt had run at
+  /// least this long (JobStore::recover).
+  double charge_after_s = 30.0;
   std::size_t max_body_bytes = std::size_t{16} << 20;  ///< request body limit (413)
   int max_event_streams = 8;           ///< concurrent GET /jobs/{id}/events (503 beyond)
   int http_threads = 24;               ///< connections served at once
@@ -44,6 +47,10 @@ struct ServiceConfig {
   /// ended, at start-up and hourly; 0 keeps them forever (retention.hpp).
   int retain_days = 30;
   double retention_interval_s = 3600.0;  ///< how often run() purges
+  /// stop(): how long connections may finish their requests before their
+  /// sockets are shut down (a client trickling a request holds its thread
+  /// for ever otherwise).
+  double shutdown_drain_s = 5.0;
 };
 
 class Service {
@@ -59,12 +66,15 @@ class Service {
 
   /// Binds the listening socket; returns the port, or -1 if binding failed.
   int bind();
-  /// Starts the workers and serves until stop(); then cancels running jobs,
-  /// puts them back in the queue and joins every thread. Returns false if
+  /// Starts the workers and serves until stop(); then joins every thread
+  /// (the workers have put their jobs back in the queue). Returns false if
   /// serving could not start.
   bool run();
-  /// Thread-safe and idempotent: stop accepting, end event streams, make
-  /// run() return.
+  /// Thread-safe and idempotent: stop claiming jobs and cancel the running
+  /// ones (their workers put them back in the queue), stop accepting, end
+  /// event streams, give open connections shutdown_drain_s to finish, then
+  /// shut down the sockets of those left so run() returns. Returns once run()
+  /// has stopped serving, or about 2 s after the drain if it cannot.
   void stop();
   /// True once run() is accepting connections.
   bool is_running() const;

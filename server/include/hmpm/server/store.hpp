@@ -19,7 +19,7 @@
 // Domain outcomes (unknown job, queue full, idempotency conflict, lost claim)
 // are values; only a failing database (disk full, corrupt file, newer schema,
 // a file another process holds) throws StoreFailure, which the HTTP edge
-// turns into a 500 and start-up into exit 1.
+// turns into 503 or 507 with Retry-After and start-up into exit 1.
 #pragma once
 
 #include <chrono>
@@ -43,10 +43,17 @@ namespace hmpm::server {
 /// to age jobs without sleeping.
 using WallClock = std::function<std::chrono::system_clock::time_point()>;
 
-/// A database failure the service cannot recover from by itself.
+/// A database failure the service cannot recover from by itself. `no_space`:
+/// the write failed for want of space (disk full, quota, file-size limit),
+/// which the HTTP edge answers 507 instead of 503.
 class StoreFailure : public std::runtime_error {
  public:
-  using std::runtime_error::runtime_error;
+  explicit StoreFailure(const std::string& what, bool no_space = false)
+      : std::runtime_error(what), no_space_(no_space) {}
+  bool no_space() const { return no_space_; }
+
+ private:
+  bool no_space_ = false;
 };
 
 /// What parse_job estimated a job will cost, kept for the status document.
@@ -116,6 +123,10 @@ struct SubmitResult {
   JobRecord job;
 };
 
+/// recover(): how many starts, in units of max_attempts, a job may have
+/// without a charged crash before it fails anyway.
+inline constexpr int uncharged_start_factor = 3;
+
 /// What start-up recovery did with jobs an earlier process left `running`.
 struct RecoveryReport {
   std::vector<std::string> requeued;
@@ -163,7 +174,8 @@ class JobStore {
  public:
   virtual ~JobStore() = default;
 
-  /// Reads the store (a cheap probe for /health); throws StoreFailure if it cannot.
+  /// Reads the store and, at most about once a second, writes to it (a
+  /// probe for /health); throws StoreFailure if either fails.
   virtual void probe() = 0;
 
   /// Stores a new accepted job unless the queue holds `max_queue` accepted
@@ -221,10 +233,17 @@ class JobStore {
 
   virtual std::vector<ResultFile> results(const std::string& id) = 0;
 
-  /// Recovery: every running job whose lease has lapsed goes back to
-  /// `accepted` while attempts < max_attempts, else to `failed` with the
-  /// reason. Jobs with a live lease are left alone, whoever owns them.
-  virtual RecoveryReport recover(int max_attempts) = 0;
+  /// Recovery: every running job whose lease has lapsed (its server died)
+  /// goes back to `accepted`, or to `failed` with the reason. The crash is
+  /// charged to the job only if its attempt had been running for at least
+  /// `charge_after_s` (claim to its last lease renewal or progress write):
+  /// a job claimed just before an unrelated crash is innocent. A job fails
+  /// once max_attempts crashes were charged to it, or, as a backstop against
+  /// a job that kills its server within charge_after_s of every start, once
+  /// it was started uncharged_start_factor * max_attempts times. Queued jobs
+  /// are never charged. Jobs with a live lease are left alone, whoever owns
+  /// them.
+  virtual RecoveryReport recover(int max_attempts, double charge_after_s) = 0;
 
   virtual StatusCounts count_by_status() = 0;
 
