@@ -19,10 +19,6 @@ std::vector<LimitExceeded> exceeded_limits(const hmpm::api::CostEstimate& cost,
         static_cast<double>(cost.particle_steps));
   check(config.max_job_memory > 0, "max_job_memory", "--max-job-memory", "bytes",
         static_cast<double>(config.max_job_memory), static_cast<double>(cost.memory_bytes));
-  // A job expected to run longer than its wall time would be stopped at the
-  // limit with nothing to show: refused instead.
-  check(config.job_wall_time_s > 0, "job_wall_time", "--job-wall-time", "seconds",
-        config.job_wall_time_s, cost.wall_seconds);
   return over;
 }
 

@@ -1,11 +1,13 @@
 // job_limits.hpp — what one job may cost on this server, checked at submit
-// from the cost estimate: particle-steps, memory (threads and series
-// counted, api/src/cost.cpp) and expected wall time. Each limit is an
-// hmpm-server option; a job over one is refused with 422 limit-exceeded
-// naming the limit, its value, the job's estimate and the option
-// (docs/api.md, "Limits"). The particle count is bounded earlier, by the
-// parser (hmpm::api::Limits::max_particles, from --max-particles), before
-// anything is allocated per particle.
+// from the cost estimate: particle-steps and memory (threads and series
+// counted, api/src/cost.cpp). Each limit is an hmpm-server option; a job
+// over one is refused with 422 limit-exceeded naming the limit, its value,
+// the job's estimate and the option (docs/api.md, "Limits"). The particle
+// count is bounded earlier, by the parser (hmpm::api::Limits::max_particles,
+// from --max-particles), before anything is allocated per particle. The
+// wall-time limit (--job-wall-time) is not checked against the estimate,
+// which depends on the calibration: it stops the run itself, set-up
+// included (RunOptions::wall_time_limit_s).
 #pragma once
 
 #include <cstdint>
@@ -19,10 +21,10 @@ namespace hmpm::server {
 
 /// One limit a job's estimate is over.
 struct LimitExceeded {
-  std::string limit;   ///< "max_particle_steps", "max_job_memory", "job_wall_time"
-  std::string option;  ///< the hmpm-server option that sets it
-  std::string unit;    ///< "particle-steps", "bytes", "seconds"
-  double value = 0;    ///< the limit
+  std::string limit;    ///< "max_particle_steps", "max_job_memory"
+  std::string option;   ///< the hmpm-server option that sets it
+  std::string unit;     ///< "particle-steps", "bytes"
+  double value = 0;     ///< the limit
   double estimate = 0;  ///< the job's
 };
 

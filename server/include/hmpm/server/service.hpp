@@ -29,8 +29,7 @@ struct ServiceConfig {
   int threads_per_job = 0;         ///< solver threads per job; <= 0: cores / workers
   std::string token;               ///< non-empty: Bearer token required (not on /health)
   long max_queue = 1000;           ///< accepted jobs before POST /jobs answers 503
-  /// Per-job wall-clock limit, set-up included; a job whose estimate is
-  /// over it is refused at submit. <= 0: none.
+  /// Per-job wall-clock limit, set-up included; <= 0: none.
   double job_wall_time_s = 86'400.0;
   std::int64_t max_particles = 2'000'000;  ///< particles per job (the parser's budget)
   /// Particles x steps per job, refused at submit beyond (about a day of one
