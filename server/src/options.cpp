@@ -4,6 +4,7 @@
 #include <charconv>
 #include <cmath>
 #include <functional>
+#include <limits>
 #include <map>
 
 namespace hmpm::server {
@@ -35,7 +36,8 @@ bool parse_seconds(const std::string& text, double& out) {
 std::string usage() {
   return "usage: hmpm-server [--host H] [--port P] --db PATH [--workers N] [--data-dir DIR]\n"
          "                   [--threads-per-job N] [--token T] [--max-queue N]\n"
-         "                   [--job-wall-time S] [--max-attempts N] [--charge-after S]\n"
+         "                   [--job-wall-time S] [--max-particles N] [--max-particle-steps N]\n"
+         "                   [--max-job-memory B] [--max-attempts N] [--charge-after S]\n"
          "                   [--max-body-bytes N]\n"
          "                   [--max-event-streams N] [--http-threads N] [--retain-days N]\n"
          "  --host H              address to listen on (default 127.0.0.1)\n"
@@ -46,7 +48,13 @@ std::string usage() {
          "  --threads-per-job N   solver threads per job (default: cores / workers)\n"
          "  --token T             require 'Authorization: Bearer T' (default: $HMPM_TOKEN)\n"
          "  --max-queue N         queued jobs before POST /jobs answers 503 (default 1000)\n"
-         "  --job-wall-time S     fail a job running longer than S seconds (default: none)\n"
+         "  --job-wall-time S     fail a job running (set-up included) longer than S seconds;\n"
+         "                        0: none (default 86400)\n"
+         "  --max-particles N     particles per job, refused beyond (default 2000000)\n"
+         "  --max-particle-steps N  particles x steps per job, refused beyond; 0: none\n"
+         "                        (default 1000000000000)\n"
+         "  --max-job-memory B    estimated memory per job in bytes, refused beyond; 0: none\n"
+         "                        (default: half the physical memory / workers)\n"
          "  --max-attempts N      crashes charged to a job before recovery fails it (default 3)\n"
          "  --charge-after S      a crash is charged to a running job only if its attempt ran\n"
          "                        at least S seconds (default 30)\n"
@@ -107,6 +115,11 @@ ParsedOptions parse_options(const std::vector<std::string>& args, const char* en
          return parse_seconds(v, config.job_wall_time_s) ? std::string()
                                                          : std::string("must be seconds >= 0");
        }},
+      {"--max-particles", integer(1, 1'000'000'000, [&](long n) { config.max_particles = n; })},
+      {"--max-particle-steps", integer(0, std::numeric_limits<long>::max(),
+                                       [&](long n) { config.max_particle_steps = n; })},
+      {"--max-job-memory", integer(0, std::numeric_limits<long>::max(),
+                                   [&](long n) { config.max_job_memory = n > 0 ? n : -1; })},
       {"--max-attempts",
        integer(1, 1000, [&](long n) { config.max_attempts = static_cast<int>(n); })},
       {"--charge-after",

@@ -16,6 +16,8 @@
 #include "hmpm/server/store.hpp"
 #include "http/drain.hpp"
 #include "http/server_setup.hpp"
+#include "http/validation_gate.hpp"
+#include "job_limits.hpp"
 #include "job_log.hpp"
 #include "metrics.hpp"
 #include "process_lock.hpp"
@@ -34,6 +36,7 @@ ServiceConfig resolved(ServiceConfig c) {
     const int cores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
     c.threads_per_job = std::max(1, cores / std::max(1, c.workers));
   }
+  if (c.max_job_memory == 0) c.max_job_memory = default_job_memory(c.workers);
   if (!c.db_path.parent_path().empty())
     std::filesystem::create_directories(c.db_path.parent_path());
   std::filesystem::create_directories(c.data_dir);
@@ -43,6 +46,7 @@ ServiceConfig resolved(ServiceConfig c) {
 hmpm::api::Limits limits_for(const ServiceConfig& c) {
   hmpm::api::Limits limits;
   limits.max_body_bytes = static_cast<std::int64_t>(c.max_body_bytes);
+  limits.max_particles = c.max_particles;
   return limits;
 }
 
@@ -57,6 +61,15 @@ WorkerSettings worker_settings(const ServiceConfig& c, const hmpm::api::Limits& 
                         .claimant = Claimant{instance, c.lease_s},
                         .lease_renewal_s = c.lease_s / 3.0};
 }
+
+// Validations running at once: half the cores (at least one), so the
+// workers and the other HTTP threads keep a core; a quarter of the HTTP
+// threads may hold a request for one (http/validation_gate.hpp), each
+// waiting at most validation_wait_s for its turn.
+int validation_turns() {
+  return std::max(1, static_cast<int>(std::thread::hardware_concurrency()) / 2);
+}
+constexpr double validation_wait_s = 10.0;
 
 void log_recovery(const RecoveryReport& recovery) {
   for (const auto& id : recovery.requeued) {
@@ -84,7 +97,8 @@ struct Service::Impl {
         limits(limits_for(config)),
         store(open_sqlite_store(config.db_path)),
         workers(*store, metrics, worker_settings(config, limits, instance_id)),
-        context{config, limits, *store, metrics, workers, stopping},
+        validation(validation_turns(), std::max(2, config.http_threads / 4), validation_wait_s),
+        context{config, limits, *store, metrics, workers, stopping, validation},
         auth(config.token),
         router(http::route_table(), context, auth) {
     log_recovery(store->recover(config.max_attempts, config.charge_after_s));
@@ -99,6 +113,7 @@ struct Service::Impl {
   Metrics metrics;
   WorkerPool workers;
   std::atomic<bool> stopping{false};
+  http::ValidationGate validation;
   http::Context context;
   http::Authenticator auth;
   http::Router router;
@@ -175,7 +190,11 @@ bool Service::run() {
             {"data_dir", s.config.data_dir.string()},
             {"instance", s.instance_id},
             {"auth", !s.config.token.empty()},
-            {"retain_days", s.config.retain_days}});
+            {"retain_days", s.config.retain_days},
+            {"job_wall_time_s", s.config.job_wall_time_s},
+            {"max_particles", s.config.max_particles},
+            {"max_particle_steps", s.config.max_particle_steps},
+            {"max_job_memory", s.config.max_job_memory}});
   std::thread retention;
   if (s.config.retain_days > 0) retention = std::thread([&s] { s.retention_loop(); });
   const bool ok = s.stopping || s.server.listen_after_bind();

@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "hmpm/format.hpp"
+#include "interrupt.hpp"
 #include "materials/material.hpp"
 #include "particle_layout.hpp"
 
@@ -184,7 +185,7 @@ std::vector<ProblemIssue> check_geostatic(const Problem& problem) {
   return issues;
 }
 
-GeostaticState geostatic_state(const Problem& problem) {
+GeostaticState geostatic_state(const Problem& problem, const SetupInterrupt* interrupt) {
   const Geostatic& geo = *problem.initial_state.geostatic;
   const Vertical v = vertical_of(problem);
   const std::vector<BodyExtent> extents = body_extents(problem);
@@ -204,6 +205,7 @@ GeostaticState geostatic_state(const Problem& problem) {
     if (mat < geo.material_k0.size() && geo.material_k0[mat]) k0 = *geo.material_k0[mat];
     const std::int64_t count = body_layout(problem, problem.bodies[b]).count;
     for (std::int64_t k = 0; k < count; ++k, ++p) {
+      if (interrupt) interrupt->poll(p);
       const Vec3& x = positions[p];
       const double elevation = v.up * x[v.axis];
       // Weight of the column above the particle, per unit area.

@@ -20,13 +20,17 @@
 namespace hmpm {
 
 template <int Dim, class Shape>
-Simulation<Dim, Shape>::Simulation(const Problem& problem) : problem_(problem) {
+Simulation<Dim, Shape>::Simulation(const Problem& problem, const RunOptions& options)
+    : problem_(problem), interrupt_(options.cancel, options.wall_time_limit_s) {
   setup_grid();
   setup_materials();
   setup_particles();
+  interrupt_.stage("compiling boundaries and tractions");
+  interrupt_.check();
   constraints_ = compile_constraints<Dim>(problem_, grid_, grid_max_, fluid_);
   tractions_ = compile_tractions<Dim>(problem_, particles_, grid_);
   setup_geostatic();
+  interrupt_.check();
 }
 
 template <int Dim, class Shape>
@@ -67,6 +71,7 @@ void Simulation<Dim, Shape>::setup_materials() {
 template <int Dim, class Shape>
 void Simulation<Dim, Shape>::setup_particles() {
   const bool gimp = std::is_same_v<Shape, shape::Gimp>;
+  interrupt_.stage("generating particles and evaluating their initial fields");
   particles_.resize(static_cast<std::size_t>(count_particles(problem_)), fluid_, gimp,
                     state_variables_);
   grid_.resize(fluid_);
@@ -81,6 +86,7 @@ void Simulation<Dim, Shape>::setup_particles() {
     for (double z : layout.coords[2])
       for (double y : layout.coords[1])
         for (double x : layout.coords[0]) {
+          interrupt_.poll(p);
           const Vec3 x3{x, y, z};
           for (int a = 0; a < Dim; ++a) particles_.x[p][a] = x3[a];
           particles_.x0[p] = particles_.x[p];
@@ -116,7 +122,8 @@ void Simulation<Dim, Shape>::setup_particles() {
 template <int Dim, class Shape>
 void Simulation<Dim, Shape>::setup_geostatic() {
   if (!problem_.initial_state.geostatic) return;
-  const GeostaticState g = geostatic_state(problem_);
+  interrupt_.stage("computing the geostatic state");
+  const GeostaticState g = geostatic_state(problem_, &interrupt_);
   for (std::size_t p = 0; p < particles_.size(); ++p) {
     geostatic_voigt(g, p, particles_.stress[p].data());
     if (fluid_ && constants_[particles_.material[p]].saturated) {
@@ -140,10 +147,13 @@ void Simulation<Dim, Shape>::balance_initial_pressure_state() {
   if (scale == 0.0) return;
   StencilT s;
   double checkpoint = std::numeric_limits<double>::infinity();
+  interrupt_.stage("balancing the initial pore pressure");
   for (int iteration = 0; iteration < 500; ++iteration) {
+    interrupt_.check();
     std::fill(grid_.storage.begin(), grid_.storage.end(), 0.0);
     std::fill(grid_.pressure.begin(), grid_.pressure.end(), 0.0);
     for (std::size_t p = 0; p < particles_.size(); ++p) {
+      interrupt_.poll(p);
       const std::uint16_t mat = particles_.material[p];
       if (!constants_[mat].saturated) continue;
       stencil_of<false>(p, s);

@@ -44,6 +44,7 @@
 #include "boundary/tractions.hpp"
 #include "hmpm/problem.hpp"
 #include "hmpm/run.hpp"
+#include "interrupt.hpp"
 #include "materials/material.hpp"
 #include "parallel.hpp"
 #include "shape.hpp"
@@ -67,7 +68,9 @@ class Simulation {
   using StencilT = shape::Stencil<Dim, Shape>;
   using Out = Scatter<Dim>;
 
-  explicit Simulation(const Problem& problem);
+  /// Sets the run up; honours options.cancel and options.wall_time_limit_s
+  /// while doing so (throws SetupInterrupted, see interrupt.hpp).
+  Simulation(const Problem& problem, const RunOptions& options);
 
   /// Runs the time loop to problem.time.end (time_loop.hpp).
   RunResult run(const RunOptions& options);
@@ -228,6 +231,7 @@ class Simulation {
   void sample_series(Series& series, double t) const;
 
   const Problem& problem_;
+  SetupInterrupt interrupt_;  ///< set-up's stop checks; its start is the run's start
   GridState<Dim> grid_;
   ParticleState<Dim> particles_;
   std::vector<MaterialConstants> constants_;

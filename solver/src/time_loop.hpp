@@ -172,7 +172,8 @@ RunResult Simulation<Dim, Shape>::run(const RunOptions& options) {
       last_progress = now;
       report(n + 1, t);
       if (options.wall_time_limit_s > 0 &&
-          std::chrono::duration<double>(now - start).count() > options.wall_time_limit_s) {
+          std::chrono::duration<double>(now - interrupt_.start()).count() >
+              options.wall_time_limit_s) {  // set-up counts too
         result.status = RunStatus::failed;
         result.message = "wall-time limit of " + number(options.wall_time_limit_s) +
                          " s reached at step " + std::to_string(n + 1) + " of " +

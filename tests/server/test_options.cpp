@@ -17,6 +17,34 @@ TEST(Options, DefaultsNeedOnlyTheDatabase) {
   EXPECT_TRUE(parsed.config->token.empty());
   EXPECT_TRUE(parsed.config->data_dir.empty());  // resolved to <db dir>/results by the service
   EXPECT_EQ(parsed.config->retain_days, 30);
+  // The limits of a shared server: a day of wall time, 2 M particles,
+  // 1e12 particle-steps; memory 0 = half the physical memory / workers.
+  EXPECT_DOUBLE_EQ(parsed.config->job_wall_time_s, 86'400.0);
+  EXPECT_EQ(parsed.config->max_particles, 2'000'000);
+  EXPECT_EQ(parsed.config->max_particle_steps, 1'000'000'000'000);
+  EXPECT_EQ(parsed.config->max_job_memory, 0);
+}
+
+TEST(Options, JobLimitsAreReadAndZeroMeansNone) {
+  const auto set = parse_options({"--db", "d", "--max-particles", "1000", "--max-particle-steps",
+                                  "5000000", "--max-job-memory", "1048576"},
+                                 nullptr);
+  ASSERT_TRUE(set.config) << set.error;
+  EXPECT_EQ(set.config->max_particles, 1000);
+  EXPECT_EQ(set.config->max_particle_steps, 5'000'000);
+  EXPECT_EQ(set.config->max_job_memory, 1 << 20);
+  const auto none = parse_options(
+      {"--db", "d", "--max-particle-steps", "0", "--max-job-memory", "0", "--job-wall-time", "0"},
+      nullptr);
+  ASSERT_TRUE(none.config) << none.error;
+  EXPECT_EQ(none.config->max_particle_steps, 0);
+  EXPECT_LT(none.config->max_job_memory, 0);  // none, not "the default"
+  EXPECT_DOUBLE_EQ(none.config->job_wall_time_s, 0.0);
+  EXPECT_NE(
+      parse_options({"--db", "d", "--max-particles", "0"}, nullptr).error.find("--max-particles"),
+      std::string::npos);
+  for (const char* flag : {"--max-particles N", "--max-particle-steps N", "--max-job-memory B"})
+    EXPECT_NE(usage().find(flag), std::string::npos) << flag;
 }
 
 TEST(Options, RetainDaysZeroKeepsForeverAndNegativeIsRefused) {

@@ -792,6 +792,44 @@ TEST_F(RoutesTest, ShortIdPrefixesNameOneJobAndAmbiguousOnesAreRefused) {
   EXPECT_EQ(json_of(client_->Get(("/jobs/" + id).c_str())->body)["status"], "dismissed");
 }
 
+// Issue 22 items 6 and 7: a job over a limit of the server is refused at
+// submit (and by /validate) with 422 limit-exceeded naming the limit, its
+// value, the job's estimate and the option; nothing is stored.
+TEST_F(RoutesTest, JobOverALimitIsRefusedNamingTheLimitAndItsOption) {
+  ServiceConfig c = config();
+  c.max_particle_steps = 1000;  // the small spec has 13 particles x 50 steps = 650
+  c.max_job_memory = 1 << 20;   // below the estimate's 16 MiB process base
+  start(c);
+  const std::string spec = small_spec("small", 0.1);  // 100 steps: 1300 particle-steps
+  for (const char* path : {"/jobs", "/validate"}) {
+    auto res = client_->Post(path, spec, "application/json");
+    ASSERT_TRUE(res);
+    ASSERT_EQ(res->status, 422) << path << ": " << res->body;
+    const Json doc = json_of(res->body);
+    EXPECT_EQ(doc["type"], "limit-exceeded");
+    ASSERT_EQ(doc["limits"].size(), 2u) << res->body;
+    EXPECT_EQ(doc["limits"][0]["limit"], "max_particle_steps");
+    EXPECT_EQ(doc["limits"][0]["option"], "--max-particle-steps");
+    EXPECT_EQ(doc["limits"][0]["value"], 1000.0);
+    EXPECT_EQ(doc["limits"][0]["estimate"], 1300.0);
+    EXPECT_EQ(doc["limits"][1]["limit"], "max_job_memory");
+    EXPECT_EQ(doc["limits"][1]["option"], "--max-job-memory");
+    EXPECT_NE(doc["detail"].get<std::string>().find("--max-particle-steps"), std::string::npos);
+  }
+  EXPECT_EQ(json_of(client_->Get("/jobs")->body)["numberReturned"], 0);
+}
+
+TEST_F(RoutesTest, FullQueueIsAnsweredBeforeTheSpecIsRead) {
+  ServiceConfig c = config();
+  c.max_queue = 0;
+  start(c);
+  // Not even JSON: a 503 queue-full, not a 400, shows nothing was parsed.
+  auto res = client_->Post("/jobs", "{not json", "application/json");
+  ASSERT_TRUE(res);
+  EXPECT_EQ(res->status, 503) << res->body;
+  EXPECT_EQ(json_of(res->body)["type"], "queue-full");
+}
+
 TEST_F(RoutesTest, ValidateAnswersValidWithWarningsAndCostOrTheInvalidSpecProblem) {
   start();
   Json spec = json_of(small_spec("check", 0.05));

@@ -35,11 +35,13 @@ struct PositionFormula {
   std::size_t body;
   std::string path;
   FieldOfPosition f;
+  std::size_t length = 0;  ///< characters: what one evaluation costs, roughly
 };
 /// A formula of time read from the spec, checked over [0, end].
 struct TimeFormula {
   std::string path;
   FieldOfTime f;
+  std::size_t length = 0;  ///< characters
 };
 /// An output.series particle given as {"near": [...]}, resolved once the
 /// particles are known.
@@ -64,7 +66,9 @@ struct ParseContext {
   std::vector<PendingNear> near;
   std::vector<PositionFormula> position_formulas;
   std::vector<TimeFormula> time_formulas;
-  bool damping_formula = false;  ///< local_damping given as a formula of t
+  bool damping_formula = false;         ///< local_damping given as a formula of t
+  std::int64_t formula_characters = 0;  ///< of every formula read so far
+  std::size_t formulas = 0;             ///< formulas read so far
   std::vector<std::string> traction_paths;
   bool any_pore_pressure_bc = false;
   std::string first_pore_pressure_bc;

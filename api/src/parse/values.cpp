@@ -9,6 +9,30 @@ namespace {
 constexpr std::string_view box_allowed[] = {"min", "max"};
 constexpr std::string_view selection_allowed[] = {"box"};
 
+// Counts a formula against the spec's formula budget (Limits::max_formulas,
+// max_formula_characters); false, with an error at `path`, when over it.
+bool admit_formula(ParseContext& c, const std::string& text, const std::string& path) {
+  ++c.formulas;
+  c.formula_characters += static_cast<std::int64_t>(text.size());
+  if (c.formulas == static_cast<std::size_t>(c.limits.max_formulas) + 1) {
+    c.r.error(path, "is formula number " + std::to_string(c.formulas) +
+                        "; a spec may hold at most " + std::to_string(c.limits.max_formulas) +
+                        " formulas (limit max_formulas); use numbers where the value is constant");
+    return false;
+  }
+  if (c.formulas > static_cast<std::size_t>(c.limits.max_formulas)) return false;
+  const std::int64_t before = c.formula_characters - static_cast<std::int64_t>(text.size());
+  if (c.formula_characters > c.limits.max_formula_characters) {
+    if (before <= c.limits.max_formula_characters)
+      c.r.error(path, "brings the formulas of the spec to " + std::to_string(c.formula_characters) +
+                          " characters; at most " +
+                          std::to_string(c.limits.max_formula_characters) +
+                          " in all (limit max_formula_characters)");
+    return false;
+  }
+  return true;
+}
+
 }  // namespace
 
 Keys box_key_names() {
@@ -80,9 +104,11 @@ std::optional<Box> read_selection(ParseContext& c, const json& j, const std::str
 
 FieldOfPosition read_value_of_position(ParseContext& c, const json& j, const std::string& path) {
   if (j.is_string()) {
+    if (!admit_formula(c, j.get_ref<const std::string&>(), path)) return {};
     std::string error;
     if (auto f = compile_field_of_position(j.get_ref<const std::string&>(), error)) {
-      c.position_formulas.push_back({c.p.bodies.size(), path, *f});
+      c.position_formulas.push_back(
+          {c.p.bodies.size(), path, *f, j.get_ref<const std::string&>().size()});
       return *f;
     }
     c.r.error(path, error);
@@ -100,9 +126,10 @@ FieldOfPosition read_value_of_position(ParseContext& c, const json& j, const std
 std::optional<FieldOfTime> read_value_of_time(ParseContext& c, const json& j,
                                               const std::string& path) {
   if (j.is_string()) {
+    if (!admit_formula(c, j.get_ref<const std::string&>(), path)) return std::nullopt;
     std::string error;
     if (auto f = compile_field_of_time(j.get_ref<const std::string&>(), error)) {
-      c.time_formulas.push_back({path, *f});
+      c.time_formulas.push_back({path, *f, j.get_ref<const std::string&>().size()});
       return f;
     }
     c.r.error(path, error);

@@ -150,9 +150,13 @@ struct RunOptions {
   double progress_interval_s = 0.5;
   /// Called for every snapshot as it is taken (written by the caller, not kept).
   std::function<void(const Snapshot&)> on_snapshot;
-  /// Checked once per step; when it becomes true the run stops as cancelled.
+  /// Checked once per step, and every few hundred particles during set-up
+  /// (particle generation, initial-field formulas, geostatic state); when it
+  /// becomes true the run stops as cancelled.
   const std::atomic<bool>* cancel = nullptr;
-  /// Wall-clock limit on the time loop in seconds; <= 0: none.
+  /// Wall-clock limit on the whole run, set-up included, in seconds (checked
+  /// as often as `cancel` in set-up, at each progress report in the time
+  /// loop); <= 0: none. Reaching it fails the run with a message naming it.
   double wall_time_limit_s = 0.0;
 };
 

@@ -42,6 +42,12 @@ struct Limits {
   std::int64_t max_body_bytes = std::int64_t{16} << 20;   ///< size of the spec text
   int max_json_depth = 64;
   std::int64_t max_series_particles = 10'000;  ///< entries of output.series.particles
+  /// Formulas (strings in x, y, z or t) in one spec, and their characters
+  /// in all: compiling and checking them is validation work done before a
+  /// job is accepted, so it is bounded (each formula is at most 4096
+  /// characters besides).
+  std::int64_t max_formulas = 1000;
+  std::int64_t max_formula_characters = 65'536;
 };
 
 /// The machine speed the wall-time estimate scales with (docs/performance.md,
@@ -78,7 +84,12 @@ struct CostEstimate {
   std::int64_t steps = 0;
   double dt = 0.0;
   std::int64_t particle_steps = 0;
-  std::int64_t memory_bytes = 0;  ///< solver state estimate
+  /// Peak memory of the run: particle and grid state, the grid buffers of
+  /// every solver thread (Calibration::threads), the series kept in memory
+  /// until the end, one snapshot's arrays and set-up's temporaries
+  /// (docs/performance.md, "Memory estimate").
+  std::int64_t memory_bytes = 0;
+  int threads = 1;                ///< solver threads the estimate assumes
   std::int64_t output_bytes = 0;  ///< result files estimate
   std::int64_t series_rows = 0;
   std::int64_t snapshots = 0;

@@ -29,7 +29,15 @@ struct ServiceConfig {
   int threads_per_job = 0;         ///< solver threads per job; <= 0: cores / workers
   std::string token;               ///< non-empty: Bearer token required (not on /health)
   long max_queue = 1000;           ///< accepted jobs before POST /jobs answers 503
-  double job_wall_time_s = 0.0;    ///< per-job wall-clock limit; <= 0: none
+  /// Per-job wall-clock limit, set-up included; <= 0: none.
+  double job_wall_time_s = 86'400.0;
+  std::int64_t max_particles = 2'000'000;  ///< particles per job (the parser's budget)
+  /// Particles x steps per job, refused at submit beyond (about a day of one
+  /// thread at the built-in calibration, 1e-7 s per particle-step); <= 0: none.
+  std::int64_t max_particle_steps = 1'000'000'000'000;
+  /// Estimated memory per job (cost.memory_bytes), refused at submit
+  /// beyond; 0: half the physical memory / workers (job_limits.hpp); < 0: none.
+  std::int64_t max_job_memory = 0;
   int max_attempts = 3;            ///< crashes charged to a job before recovery fails it
   /// A crash is charged to a running job only when its attempt had run at
   /// least this long (JobStore::recover).
