@@ -140,6 +140,34 @@ struct Series {
   std::vector<std::vector<double>> values;
 };
 
+/// The complete state of a run after `step`, as opaque bytes (the solver's
+/// versioned binary format, checkpoint.hpp): RunOptions::resume with these
+/// bytes continues the run to results bit-identical to an uninterrupted run
+/// at the same thread count.
+struct Checkpoint {
+  std::int64_t step = 0;
+  double time = 0.0;  ///< simulated time, s
+  std::string bytes;
+};
+
+/// What a checkpoint holds, read from its header and output bookkeeping.
+struct CheckpointInfo {
+  int version = 0;
+  std::int64_t step = 0;
+  double time = 0.0;  ///< simulated time, s
+  std::int64_t particles = 0;
+  int threads = 1;                     ///< solver threads of the run that wrote it
+  std::vector<double> snapshot_times;  ///< snapshots 0.. already taken, in order
+};
+
+/// Reads and checks `bytes` as a checkpoint of `problem` run with
+/// `checkpoint_key` (RunOptions::checkpoint_key): magic, version,
+/// dimension, shape function, scheme, particle count, the hash of the key
+/// and of the problem's set-up figures, and the checksum of the whole.
+/// Throws std::invalid_argument saying what does not match.
+CheckpointInfo inspect_checkpoint(const Problem& problem, const std::string& checkpoint_key,
+                                  const std::string& bytes);
+
 struct RunOptions {
   int threads = 1;  ///< solver threads; <= 0 means every core
   /// Fewer particles than this per thread and the run uses fewer threads:
@@ -152,8 +180,22 @@ struct RunOptions {
   std::function<void(const Snapshot&)> on_snapshot;
   /// Checked once per step; when it becomes true the run stops as cancelled.
   const std::atomic<bool>* cancel = nullptr;
-  /// Wall-clock limit on the time loop in seconds; <= 0: none.
+  /// Wall-clock limit on the time loop in seconds; <= 0: none. A resumed
+  /// run counts the loop time of the runs before it.
   double wall_time_limit_s = 0.0;
+  /// Called with a checkpoint of the whole run state after the first step
+  /// that ends `checkpoint_interval_s` or more of wall time after the start
+  /// or the last checkpoint (<= 0: never). The bytes are the caller's to
+  /// store; the buffer is reused by the next call.
+  std::function<void(const Checkpoint&)> on_checkpoint;
+  double checkpoint_interval_s = 60.0;
+  /// Names the job a checkpoint belongs to (e.g. its spec text): its hash is
+  /// in every checkpoint, and a checkpoint is resumed only with the same key.
+  std::string checkpoint_key;
+  /// Checkpoint bytes to continue from (from on_checkpoint of an earlier run
+  /// of the same problem and key); null: start at t = 0. A checkpoint that
+  /// does not belong to the problem makes run() throw std::invalid_argument.
+  const std::string* resume = nullptr;
 };
 
 enum class RunStatus { successful, failed, cancelled };
@@ -168,7 +210,7 @@ struct RunResult {
   double dt = 0.0;
   std::int64_t particles = 0;
   std::int64_t nodes = 0;
-  double solve_seconds = 0.0;  ///< wall time of the time loop only
+  double solve_seconds = 0.0;  ///< wall time of the time loop only (all runs, when resumed)
   double particle_steps_per_second = 0.0;
   std::int64_t state_bytes = 0;     ///< particle + grid state in memory
   int threads = 1;                  ///< solver threads actually used
