@@ -79,8 +79,7 @@ Header read_header(Reader& r, const std::string& bytes, const Problem& problem,
            std::to_string(problem.dimension));
   if (h.shape != static_cast<std::uint32_t>(problem.shape_function))
     refuse("another shape function");
-  if (h.scheme != static_cast<std::uint32_t>(problem.time.scheme))
-    refuse("another time scheme");
+  if (h.scheme != static_cast<std::uint32_t>(problem.time.scheme)) refuse("another time scheme");
   const std::int64_t particles = count_particles(problem);
   if (h.particles != particles)
     refuse(std::to_string(h.particles) + " particles, this problem has " +

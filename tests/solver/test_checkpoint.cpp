@@ -142,13 +142,13 @@ TEST_P(Resume, FromAMidRunCheckpointGivesTheUninterruptedResultsBitForBit) {
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   EXPECT_EQ(info.step, k);
   EXPECT_EQ(info.particles, whole.result.particles);
-  std::printf("%s: %lld steps, checkpoint at step %lld: %zu bytes, %.1f bytes per particle, "
-              "inspected in %.2g s\n",
-              hmpm::scheme_name(GetParam()), static_cast<long long>(steps),
-              static_cast<long long>(k), first.checkpoint.size(),
-              static_cast<double>(first.checkpoint.size()) /
-                  static_cast<double>(whole.result.particles),
-              inspect_s);
+  std::printf(
+      "%s: %lld steps, checkpoint at step %lld: %zu bytes, %.1f bytes per particle, "
+      "inspected in %.2g s\n",
+      hmpm::scheme_name(GetParam()), static_cast<long long>(steps), static_cast<long long>(k),
+      first.checkpoint.size(),
+      static_cast<double>(first.checkpoint.size()) / static_cast<double>(whole.result.particles),
+      inspect_s);
 
   const Outputs resumed = run(p, -1, &first.checkpoint);
   ASSERT_EQ(resumed.result.status, hmpm::RunStatus::successful) << resumed.result.message;
@@ -177,9 +177,10 @@ TEST_P(Resume, FromAMidRunCheckpointGivesTheUninterruptedResultsBitForBit) {
 
 INSTANTIATE_TEST_SUITE_P(Schemes, Resume,
                          ::testing::Values(hmpm::Scheme::explicit_scheme,
-                                           hmpm::Scheme::semi_implicit,
-                                           hmpm::Scheme::quasi_static),
-                         [](const auto& info) { return std::string(hmpm::scheme_name(info.param)); });
+                                           hmpm::Scheme::semi_implicit, hmpm::Scheme::quasi_static),
+                         [](const auto& info) {
+                           return std::string(hmpm::scheme_name(info.param));
+                         });
 
 /// The message run() refuses `bytes` with (empty when it does not).
 std::string refusal(const hmpm::Problem& p, const std::string& bytes,
