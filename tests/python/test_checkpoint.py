@@ -49,16 +49,16 @@ KILLS = ((30.0, 0.45 * INTERVAL_S), (65.0, 0.85 * INTERVAL_S))
 WALL_FIELDS = ("solve_seconds", "particle_steps_per_second")
 
 
-def spec() -> dict:
+def spec(end: float = END_S) -> dict:
     s = copy.deepcopy(BAR_SPEC)
     s["name"] = "pytest-checkpoint"
     s["grid"] = {"min": [0.0], "max": [1.2], "cells": [2400]}  # room for the free end
     s["bodies"][0]["particles_per_cell"] = 2
-    s["time"] = {"end": END_S, "dt": 1.0e-5}
+    s["time"] = {"end": end, "dt": 1.0e-5}
     s["output"] = {
         "series": {"particles": [0, 1999, 3999], "fields": ["displacement", "velocity"],
-                   "interval": END_S / 200},
-        "snapshots": {"interval": END_S / 6},
+                   "interval": end / 200},
+        "snapshots": {"interval": end / 6},
     }
     return s
 
@@ -241,6 +241,29 @@ class CheckpointedJobSurvivesKills(unittest.TestCase):
             self.assertGreater(int(step), 0)
         total_s = time.monotonic() - t_start
         print(f"uninterrupted run {reference_s:.1f} s, whole test {total_s:.1f} s")
+
+    def test_a_corrupt_checkpoint_is_not_used_and_the_job_starts_again(self):
+        srv = self.start("corrupt", ["--checkpoint-interval", str(INTERVAL_S)])
+        end = 0.6  # ~3 s
+        job = srv.submit(spec(end))
+        deadline = time.monotonic() + 30
+        while "checkpoint at step" not in srv.get(f"/jobs/{job}/log").decode():
+            self.assertLess(time.monotonic(), deadline, "no checkpoint within 30 s")
+            time.sleep(0.05)
+        srv.kill()
+        files = list((self.tmp / "corrupt" / "results" / job).glob("checkpoint-*.hmpmck"))
+        self.assertEqual(len(files), 1, files)
+        data = bytearray(files[0].read_bytes())
+        data[len(data) // 2] ^= 0x01
+        files[0].write_bytes(bytes(data))
+        srv.start()
+        doc = srv.wait(job, done, 60)
+        self.assertEqual(doc["status"], "successful", doc)
+        log = srv.get(f"/jobs/{job}/log").decode()
+        self.assertIn("does not have the recorded SHA-256): starting from step 0", log)
+        self.assertNotIn("resumed from the checkpoint", log)
+        summary = json.loads(srv.get(f"/jobs/{job}/results/summary.json"))
+        self.assertEqual(summary["steps"], round(end / 1.0e-5))
 
 
 if __name__ == "__main__":
