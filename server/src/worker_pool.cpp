@@ -401,6 +401,9 @@ void WorkerPool::run_one(const JobRecord& job, Running& running) {
     if (resume) options.resume = &*resume;
     if (settings_.checkpoint_interval_s > 0) {
       options.on_checkpoint = [&](const hmpm::Checkpoint& c) {
+        // The solver's last checkpoint of a cancelled run is kept for a
+        // shutdown only (a dismissed job, or one another claim took, is over).
+        if (running.dismissed || running.lost) return;
         const auto t1 = SteadyClock::now();
         const std::string name = checkpoint_prefix + std::to_string(claim.token) + "-" +
                                  std::to_string(c.step) + checkpoint_suffix;

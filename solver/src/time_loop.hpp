@@ -151,8 +151,11 @@ RunResult Simulation<Dim, Shape>::run(const RunOptions& options) {
   auto last_checkpoint = start;
   const bool want_checkpoints = options.on_checkpoint && options.checkpoint_interval_s > 0;
   Checkpoint ckpt;
-  auto write_checkpoint = [&](Clock::time_point now) {
-    ckpt.step = n + 1;
+  std::int64_t checkpointed = n;  // steps done at the last checkpoint (or the resume)
+  // The state after `done` steps (t the time reached).
+  auto write_checkpoint = [&](std::int64_t done, Clock::time_point now) {
+    checkpointed = done;
+    ckpt.step = done;
     ckpt.time = t;
     ckpt.bytes.clear();
     checkpoint::Writer w(ckpt.bytes);
@@ -163,7 +166,7 @@ RunResult Simulation<Dim, Shape>::run(const RunOptions& options) {
     h.particles = static_cast<std::int64_t>(particles_.size());
     h.fingerprint = checkpoint::fingerprint(problem_, options.checkpoint_key);
     h.threads = threads;
-    h.step = n + 1;
+    h.step = done;
     h.time = t;
     h.total = total;
     h.next_series = next_series;
@@ -193,6 +196,9 @@ RunResult Simulation<Dim, Shape>::run(const RunOptions& options) {
   result.status = RunStatus::successful;
   for (; fixed ? n < total : t < end; ++n) {
     if (options.cancel && options.cancel->load(std::memory_order_relaxed)) {
+      // A last checkpoint, so that a run stopped on purpose (a server
+      // shutting down) resumes where it stopped.
+      if (want_checkpoints && n > checkpointed) write_checkpoint(n, Clock::now());
       result.status = RunStatus::cancelled;
       result.message = "cancelled at step " + std::to_string(n) + " (t = " + number(t) + " s)";
       break;
@@ -252,7 +258,7 @@ RunResult Simulation<Dim, Shape>::run(const RunOptions& options) {
     }
     if (want_checkpoints && std::chrono::duration<double>(now - last_checkpoint).count() >=
                                 options.checkpoint_interval_s) {
-      write_checkpoint(now);
+      write_checkpoint(n + 1, now);
       last_checkpoint = Clock::now();  // the interval runs from the end of the write
     }
   }

@@ -6,6 +6,7 @@
 // or corrupt ones are refused with a message saying why.
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <chrono>
 #include <cstdio>
 #include <limits>
@@ -181,6 +182,38 @@ INSTANTIATE_TEST_SUITE_P(Schemes, Resume,
                          [](const auto& info) {
                            return std::string(hmpm::scheme_name(info.param));
                          });
+
+// A run cancelled on purpose (a server shutting down) checkpoints where it
+// stopped, between the periodic checkpoints; resumed, it ends as the
+// uninterrupted run.
+TEST(Checkpoint, ACancelledRunCheckpointsWhereItStopped) {
+  const hmpm::Problem p = block(hmpm::Scheme::explicit_scheme);
+  const Outputs whole = run(p, -1, nullptr);
+  ASSERT_EQ(whole.result.status, hmpm::RunStatus::successful) << whole.result.message;
+  std::atomic<bool> cancel{false};
+  hmpm::RunOptions opt;
+  opt.threads = 2;
+  opt.min_particles_per_thread = 1;
+  opt.cancel = &cancel;
+  opt.on_snapshot = [&](const hmpm::Snapshot& s) {
+    if (s.index == 2) cancel = true;
+  };
+  opt.checkpoint_interval_s = 1e9;  // no periodic checkpoint in this run
+  opt.checkpoint_key = "spec";
+  std::vector<hmpm::Checkpoint> taken;
+  opt.on_checkpoint = [&](const hmpm::Checkpoint& c) { taken.push_back(c); };
+  const hmpm::RunResult stopped = hmpm::run(p, opt);
+  ASSERT_EQ(stopped.status, hmpm::RunStatus::cancelled);
+  ASSERT_EQ(taken.size(), 1u);
+  EXPECT_EQ(taken[0].step, stopped.steps);
+  EXPECT_EQ(hmpm::inspect_checkpoint(p, "spec", taken[0].bytes).snapshot_times.size(), 3u);
+  const Outputs resumed = run(p, -1, &taken[0].bytes);
+  ASSERT_EQ(resumed.result.status, hmpm::RunStatus::successful) << resumed.result.message;
+  EXPECT_EQ(resumed.result.steps, whole.result.steps);
+  EXPECT_EQ(resumed.result.series.values, whole.result.series.values);
+  ASSERT_EQ(resumed.snapshots.size() + 3, whole.snapshots.size());
+  expect_same_snapshot(resumed.snapshots.back(), whole.snapshots.back());
+}
 
 /// The message run() refuses `bytes` with (empty when it does not).
 std::string refusal(const hmpm::Problem& p, const std::string& bytes,

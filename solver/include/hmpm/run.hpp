@@ -185,8 +185,9 @@ struct RunOptions {
   double wall_time_limit_s = 0.0;
   /// Called with a checkpoint of the whole run state after the first step
   /// that ends `checkpoint_interval_s` or more of wall time after the start
-  /// or the last checkpoint (<= 0: never). The bytes are the caller's to
-  /// store; the buffer is reused by the next call.
+  /// or the last checkpoint (<= 0: never), and once more when the run is
+  /// cancelled after steps the last checkpoint does not hold. The bytes are
+  /// the caller's to store; the buffer is reused by the next call.
   std::function<void(const Checkpoint&)> on_checkpoint;
   double checkpoint_interval_s = 60.0;
   /// Names the job a checkpoint belongs to (e.g. its spec text): its hash is
