@@ -91,7 +91,6 @@ RunResult Simulation<Dim, Shape>::run(const RunOptions& options) {
       for (int a = 0; a < Dim; ++a) x0[a] = particles_.x[static_cast<std::size_t>(pi)][a];
       series.initial_positions.push_back(x0);
     }
-    sample_series(series, 0.0);
   }
   std::vector<Field> snapshot_fields = out.snapshot_fields;
   if (snapshot_fields.empty())
