@@ -4,7 +4,10 @@
 // .pvd collection is rewritten after each, so partial results are usable),
 // the series after the loop, summary.json last and always — also when the
 // run failed or a file could not be written (then the other files it wrote
-// are removed, so the listed files are exactly the ones left).
+// are removed, so the listed files are exactly the ones left). Checkpoints
+// (options on_checkpoint) go to the caller as the solver takes them; a run
+// resumed from one (options.resume) keeps the snapshots already in out_dir,
+// lists them in the .pvd again and takes the series so far from the checkpoint.
 #include <algorithm>
 #include <stdexcept>
 
@@ -25,6 +28,16 @@ JobOutcome run_job(const ParsedJob& job, const fs::path& out_dir, const hmpm::Ru
   JobOutcome outcome;
   std::vector<std::pair<double, std::string>> snapshots;
   std::string write_error;
+  if (options.resume) {
+    try {  // the snapshots the interrupted run wrote before its checkpoint
+      const CheckpointInfo info =
+          inspect_checkpoint(job.problem, options.checkpoint_key, *options.resume);
+      for (std::size_t i = 0; i < info.snapshot_times.size(); ++i)
+        snapshots.emplace_back(info.snapshot_times[i], snapshot_file_name(static_cast<int>(i)));
+    } catch (const std::invalid_argument&) {
+      // hmpm::run refuses the checkpoint below, with the same message
+    }
+  }
   RunOptions opts = options;
   opts.on_snapshot = [&](const Snapshot& s) {
     const std::string name = snapshot_file_name(s.index);

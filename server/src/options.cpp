@@ -40,6 +40,7 @@ std::string usage() {
          "                   [--max-job-memory B] [--max-attempts N] [--charge-after S]\n"
          "                   [--max-body-bytes N]\n"
          "                   [--max-event-streams N] [--http-threads N] [--retain-days N]\n"
+         "                   [--checkpoint-interval S]\n"
          "  --host H              address to listen on (default 127.0.0.1)\n"
          "  --port P              port; 0 picks a free one (default 8080)\n"
          "  --db PATH             SQLite database, created if missing (required)\n"
@@ -64,6 +65,9 @@ std::string usage() {
          "  --retain-days N       purge jobs that ended (successful, failed, dismissed) more than\n"
          "                        N days ago, with their files, at start-up and hourly; queued\n"
          "                        and running jobs are never purged; 0 keeps all (default 30)\n"
+         "  --checkpoint-interval S  checkpoint a running job every S seconds of wall time; a\n"
+         "                        job interrupted by a crash resumes from its last checkpoint;\n"
+         "                        0 turns checkpoints off (default 60)\n"
          "The first line on stdout is 'listening on http://HOST:PORT'. SIGTERM or SIGINT\n"
          "stops accepting, puts running jobs back in the queue and exits 0.\n";
 }
@@ -134,6 +138,12 @@ ParsedOptions parse_options(const std::vector<std::string>& args, const char* en
        integer(0, 1000, [&](long n) { config.max_event_streams = static_cast<int>(n); })},
       {"--http-threads",
        integer(2, 1024, [&](long n) { config.http_threads = static_cast<int>(n); })},
+      {"--checkpoint-interval",
+       [&](const std::string& v) {
+         return parse_seconds(v, config.checkpoint_interval_s)
+                    ? std::string()
+                    : std::string("must be seconds >= 0");
+       }},
       {"--retain-days",
        integer(0, 100'000, [&](long n) { config.retain_days = static_cast<int>(n); })},
   };

@@ -59,7 +59,8 @@ WorkerSettings worker_settings(const ServiceConfig& c, const hmpm::api::Limits& 
                         .data_dir = c.data_dir,
                         .limits = limits,
                         .claimant = Claimant{instance, c.lease_s},
-                        .lease_renewal_s = c.lease_s / 3.0};
+                        .lease_renewal_s = c.lease_s / 3.0,
+                        .checkpoint_interval_s = c.checkpoint_interval_s};
 }
 
 // Validations running at once: half the cores (at least one), so the

@@ -45,6 +45,9 @@ struct WorkerSettings {
   hmpm::api::Limits limits;
   Claimant claimant;              ///< this process's instance id and lease length
   double lease_renewal_s = 10.0;  ///< heartbeat period; well under claimant.lease_s
+  /// Wall time between checkpoints of a running job (its solver state, from
+  /// which a later attempt resumes); <= 0: none.
+  double checkpoint_interval_s = 60.0;
 };
 
 class WorkerPool {

@@ -2,8 +2,10 @@
 // series.json layout of the contract, series.csv header and rows, VTU and PVD
 // read back by an independent reader (meshio, via check_results.py), atomic
 // writes, and run_job's summary on success and on failure.
+#include <atomic>
 #include <cmath>
 #include <filesystem>
+#include <string>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -228,6 +230,55 @@ TEST(RunJob, FailedWriteLeavesOnlyASummaryAndSaysWhy) {
   EXPECT_EQ(summary["status"], "failed");
   EXPECT_NE(summary["message"].get<std::string>().find("could not write"), std::string::npos);
   EXPECT_NE(summary["message"].get<std::string>().find("removed"), std::string::npos);
+}
+
+// A run stopped after a checkpoint and resumed from it in the same folder
+// writes the files of an uninterrupted run: the snapshots before the
+// checkpoint stay (and are listed in the .pvd again), the series comes from
+// the checkpoint; summary.json differs in its wall-time fields only.
+TEST(RunJob, ResumedFromACheckpointWritesTheFilesOfAnUninterruptedRun) {
+  const ParseResult parsed =
+      parse_job(testing::read_text(testing::source_path("examples/bar-vibration.json")));
+  ASSERT_TRUE(parsed.job);
+  testing::TempDir dir;
+  const JobOutcome whole = run_job(*parsed.job, dir.path() / "whole");
+  ASSERT_EQ(whole.run.status, RunStatus::successful) << whole.run.message;
+  const std::int64_t k = whole.run.steps / 2;
+  std::string bytes;
+  std::atomic<bool> stop{false};
+  RunOptions first;
+  first.checkpoint_interval_s = 1e-12;  // every step
+  first.checkpoint_key = "bar";
+  first.cancel = &stop;
+  first.on_checkpoint = [&](const Checkpoint& c) {
+    if (c.step == k) {
+      bytes = c.bytes;
+      stop = true;
+    }
+  };
+  const JobOutcome stopped = run_job(*parsed.job, dir.path() / "resumed", first);
+  ASSERT_EQ(stopped.run.status, RunStatus::cancelled);
+  ASSERT_FALSE(bytes.empty());
+  RunOptions again;
+  again.checkpoint_key = "bar";
+  again.resume = &bytes;
+  const JobOutcome resumed = run_job(*parsed.job, dir.path() / "resumed", again);
+  ASSERT_EQ(resumed.run.status, RunStatus::successful) << resumed.run.message;
+  EXPECT_EQ(resumed.files, whole.files);
+  for (const std::string& f : whole.files) {
+    std::string a = testing::read_text(dir.path() / "whole" / f);
+    std::string b = testing::read_text(dir.path() / "resumed" / f);
+    if (f == "summary.json") {
+      json ja = json::parse(a), jb = json::parse(b);
+      for (const char* wall : {"solve_seconds", "particle_steps_per_second"}) {
+        ja.erase(wall);
+        jb.erase(wall);
+      }
+      EXPECT_EQ(ja, jb);
+    } else {
+      EXPECT_EQ(a, b) << f;
+    }
+  }
 }
 
 }  // namespace

@@ -435,6 +435,85 @@ TEST_P(StoreContract, PurgeForgetsOnlyJobsThatEndedBeforeTheCutoff) {
   EXPECT_EQ(store().submit(job("again", "done-key", "h2"), 100).outcome, SubmitOutcome::created);
 }
 
+CheckpointRecord checkpoint_at(std::int64_t step, const Claim& claim) {
+  return CheckpointRecord{"checkpoint-" + std::to_string(claim.token) + "-" + std::to_string(step),
+                          step,
+                          0.5 * static_cast<double>(step),
+                          1000 + step,
+                          std::string(64, 'c'),
+                          "2026-12-02T12:00:00.000Z"};
+}
+
+// Checkpoints: written under the claim like progress, replaced by the next
+// one, kept while the job waits to be resumed (requeue, recovery after a
+// crash, the next claim), forgotten when the job ends.
+TEST_P(StoreContract, CheckpointsAreFencedKeptForTheNextAttemptAndClearedAtTheEnd) {
+  const auto id = store().submit(job("checkpointed"), 10).job.id;
+  EXPECT_FALSE(store().checkpoint(id));
+  EXPECT_FALSE(store().checkpoint("no-such-job"));
+  const Claim never{id, live().instance, 1};
+  EXPECT_EQ(store().record_checkpoint(never, checkpoint_at(1, never)), ClaimState::lost);
+  EXPECT_FALSE(store().checkpoint(id));
+
+  const Claim first = claim_of(*store().claim_next(live()));
+  EXPECT_EQ(store().record_checkpoint(first, checkpoint_at(10, first)), ClaimState::held);
+  EXPECT_EQ(store().record_checkpoint(first, checkpoint_at(20, first)), ClaimState::held);
+  auto kept = store().checkpoint(id);
+  ASSERT_TRUE(kept);
+  EXPECT_EQ(kept->file, checkpoint_at(20, first).file);
+  EXPECT_EQ(kept->step, 20);
+  EXPECT_DOUBLE_EQ(kept->time, 10.0);
+  EXPECT_EQ(kept->size, 1020);
+  EXPECT_EQ(kept->sha256, std::string(64, 'c'));
+  EXPECT_EQ(kept->written, "2026-12-02T12:00:00.000Z");
+
+  // Requeued (graceful stop): kept, and the next claim resumes from it.
+  EXPECT_EQ(store().requeue(first), ClaimState::held);
+  EXPECT_EQ(store().checkpoint(id)->step, 20);
+  EXPECT_EQ(store().record_checkpoint(first, checkpoint_at(30, first)), ClaimState::lost);
+  const Claim second = claim_of(*store().claim_next(dead("crashed")));
+  EXPECT_EQ(store().checkpoint(id)->step, 20);
+  EXPECT_EQ(store().record_checkpoint(second, checkpoint_at(40, second)), ClaimState::held);
+  // Recovered after a crash: kept; the crashed claim's writes are refused.
+  ASSERT_EQ(store().recover(5).requeued.size(), 1u);
+  EXPECT_EQ(store().checkpoint(id)->step, 40);
+  const Claim third = claim_of(*store().claim_next(live()));
+  EXPECT_EQ(store().record_checkpoint(second, checkpoint_at(50, second)), ClaimState::lost);
+  EXPECT_EQ(store().checkpoint(id)->file, checkpoint_at(40, second).file);
+  close();  // durable
+  EXPECT_EQ(store().checkpoint(id)->step, 40);
+  EXPECT_EQ(store().record_checkpoint(third, checkpoint_at(60, third)), ClaimState::held);
+
+  EXPECT_EQ(store().finish(third, JobEnd{JobStatus::successful, "finished", "", {}, 1}),
+            ClaimState::held);
+  EXPECT_FALSE(store().checkpoint(id));
+  EXPECT_EQ(store().record_checkpoint(third, checkpoint_at(70, third)), ClaimState::lost);
+  EXPECT_FALSE(store().checkpoint(id));
+}
+
+TEST_P(StoreContract, ACancelledOrDeletedJobForgetsItsCheckpointAndRefusesNewOnes) {
+  for (bool deleted : {false, true}) {
+    const auto id = store().submit(job("stopped"), 10).job.id;
+    const Claim claim = claim_of(*store().claim_next(live()));
+    EXPECT_EQ(store().record_checkpoint(claim, checkpoint_at(5, claim)), ClaimState::held);
+    if (deleted)
+      store().dismiss(id);
+    else
+      store().cancel(id);
+    EXPECT_FALSE(store().checkpoint(id)) << (deleted ? "deleted" : "cancelled");
+    EXPECT_EQ(store().record_checkpoint(claim, checkpoint_at(6, claim)), ClaimState::dismissed);
+    EXPECT_FALSE(store().checkpoint(id));
+  }
+}
+
+TEST_P(StoreContract, AJobFailedByRecoveryForgetsItsCheckpoint) {
+  const auto id = store().submit(job("crashing"), 10).job.id;
+  const Claim claim = claim_of(*store().claim_next(dead("crashed")));
+  EXPECT_EQ(store().record_checkpoint(claim, checkpoint_at(5, claim)), ClaimState::held);
+  ASSERT_EQ(store().recover(1).failed.size(), 1u);  // attempts 1 >= max 1
+  EXPECT_FALSE(store().checkpoint(id));
+}
+
 TEST_P(StoreContract, ConcurrentWritersNeverFail) {
   constexpr int threads = 8;
   constexpr int per_thread = 40;

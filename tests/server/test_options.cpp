@@ -60,6 +60,20 @@ TEST(Options, RetainDaysZeroKeepsForeverAndNegativeIsRefused) {
   EXPECT_NE(usage().find("--retain-days N"), std::string::npos);
 }
 
+TEST(Options, CheckpointIntervalDefaultsToAMinuteAndZeroTurnsItOff) {
+  EXPECT_EQ(parse_options({"--db", "d"}, nullptr).config->checkpoint_interval_s, 60.0);
+  const auto off = parse_options({"--db", "d", "--checkpoint-interval", "0"}, nullptr);
+  ASSERT_TRUE(off.config) << off.error;
+  EXPECT_EQ(off.config->checkpoint_interval_s, 0.0);
+  const auto often = parse_options({"--db", "d", "--checkpoint-interval=1.5"}, nullptr);
+  ASSERT_TRUE(often.config) << often.error;
+  EXPECT_EQ(often.config->checkpoint_interval_s, 1.5);
+  EXPECT_NE(parse_options({"--db", "d", "--checkpoint-interval", "-1"}, nullptr)
+                .error.find("--checkpoint-interval"),
+            std::string::npos);
+  EXPECT_NE(usage().find("--checkpoint-interval S"), std::string::npos);
+}
+
 TEST(Options, EveryFlagIsRead) {
   const auto parsed =
       parse_options({"--host",   "0.0.0.0",           "--port=0", "--db",

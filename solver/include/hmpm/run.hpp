@@ -140,6 +140,34 @@ struct Series {
   std::vector<std::vector<double>> values;
 };
 
+/// The complete state of a run after `step`, as opaque bytes (the solver's
+/// versioned binary format, checkpoint.hpp): RunOptions::resume with these
+/// bytes continues the run to results bit-identical to an uninterrupted run
+/// at the same thread count.
+struct Checkpoint {
+  std::int64_t step = 0;
+  double time = 0.0;  ///< simulated time, s
+  std::string bytes;
+};
+
+/// What a checkpoint holds, read from its header and output bookkeeping.
+struct CheckpointInfo {
+  int version = 0;
+  std::int64_t step = 0;
+  double time = 0.0;  ///< simulated time, s
+  std::int64_t particles = 0;
+  int threads = 1;                     ///< solver threads of the run that wrote it
+  std::vector<double> snapshot_times;  ///< snapshots 0.. already taken, in order
+};
+
+/// Reads and checks `bytes` as a checkpoint of `problem` run with
+/// `checkpoint_key` (RunOptions::checkpoint_key): magic, version,
+/// dimension, shape function, scheme, particle count, the hash of the key
+/// and of the problem's set-up figures, and the checksum of the whole.
+/// Throws std::invalid_argument saying what does not match.
+CheckpointInfo inspect_checkpoint(const Problem& problem, const std::string& checkpoint_key,
+                                  const std::string& bytes);
+
 struct RunOptions {
   int threads = 1;  ///< solver threads; <= 0 means every core
   /// Fewer particles than this per thread and the run uses fewer threads:
@@ -157,7 +185,22 @@ struct RunOptions {
   /// Wall-clock limit on the whole run, set-up included, in seconds (checked
   /// as often as `cancel` in set-up, at each progress report in the time
   /// loop); <= 0: none. Reaching it fails the run with a message naming it.
+  /// A resumed run counts the loop time of the runs before it.
   double wall_time_limit_s = 0.0;
+  /// Called with a checkpoint of the whole run state after the first step
+  /// that ends `checkpoint_interval_s` or more of wall time after the start
+  /// or the last checkpoint (<= 0: never), and once more when the run is
+  /// cancelled after steps the last checkpoint does not hold. The bytes are
+  /// the caller's to store; the buffer is reused by the next call.
+  std::function<void(const Checkpoint&)> on_checkpoint;
+  double checkpoint_interval_s = 60.0;
+  /// Names the job a checkpoint belongs to (e.g. its spec text): its hash is
+  /// in every checkpoint, and a checkpoint is resumed only with the same key.
+  std::string checkpoint_key;
+  /// Checkpoint bytes to continue from (from on_checkpoint of an earlier run
+  /// of the same problem and key); null: start at t = 0. A checkpoint that
+  /// does not belong to the problem makes run() throw std::invalid_argument.
+  const std::string* resume = nullptr;
 };
 
 enum class RunStatus { successful, failed, cancelled };
@@ -172,7 +215,7 @@ struct RunResult {
   double dt = 0.0;
   std::int64_t particles = 0;
   std::int64_t nodes = 0;
-  double solve_seconds = 0.0;  ///< wall time of the time loop only
+  double solve_seconds = 0.0;  ///< wall time of the time loop only (all runs, when resumed)
   double particle_steps_per_second = 0.0;
   std::int64_t state_bytes = 0;     ///< particle + grid state in memory
   int threads = 1;                  ///< solver threads actually used

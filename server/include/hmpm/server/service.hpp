@@ -48,6 +48,9 @@ struct ServiceConfig {
   double progress_interval_s = 1.0;    ///< how often a running job's progress is stored
   double heartbeat_interval_s = 10.0;  ///< SSE comment line when nothing else was sent
   double lease_s = 30.0;  ///< a running job's claim lapses this long after its last renewal
+  /// Wall time between checkpoints of a running job; 0: none (a job
+  /// interrupted by a crash then starts again from step 0).
+  double checkpoint_interval_s = 60.0;
   /// Calibration of the wall-time estimate (hmpm::api::calibrate, which
   /// hmpm-server runs at start-up); <= 0: the api's built-in default.
   double seconds_per_particle_step = 0.0;

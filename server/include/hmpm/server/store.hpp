@@ -170,6 +170,17 @@ struct JobEnd {
   double run_seconds = 0.0;
 };
 
+/// A running job's last checkpoint: the solver state after `step`, in
+/// `<data-dir>/<job id>/<file>`.
+struct CheckpointRecord {
+  std::string file;
+  std::int64_t step = 0;
+  double time = 0.0;  ///< simulated time, s
+  std::int64_t size = 0;
+  std::string sha256;
+  std::string written;  ///< RFC 3339 UTC
+};
+
 class JobStore {
  public:
   virtual ~JobStore() = default;
@@ -254,6 +265,14 @@ class JobStore {
   /// purged, however old. A purged id is unknown from then on (find: nullopt).
   virtual std::vector<std::string> purge_ended(
       std::chrono::system_clock::time_point ended_before) = 0;
+
+  /// Records the checkpoint a running job just wrote (its file under the
+  /// job's data folder, named by the claim's token so a stale writer never
+  /// overwrites the current one). held: recorded; dismissed/lost as for
+  /// update_progress (the file is then the caller's to remove).
+  virtual ClaimState record_checkpoint(const Claim& claim, const CheckpointRecord& checkpoint) = 0;
+  /// The job's last recorded checkpoint, if any (cleared when the job ends).
+  virtual std::optional<CheckpointRecord> checkpoint(const std::string& id) = 0;
 };
 
 /// Opens (creating if needed) the SQLite database at `db_path` for this

@@ -85,6 +85,13 @@ void clear_results(sqlite3* db, const std::string& id) {
   clear.step();
 }
 
+// A job that ends forgets its checkpoint (the worker removes the file).
+void clear_checkpoint(sqlite3* db, const std::string& id) {
+  Statement clear(db, "DELETE FROM checkpoints WHERE job_id = ?1");
+  clear.bind(1, id);
+  clear.step();
+}
+
 void insert_results(sqlite3* db, const std::string& id, const std::vector<ResultFile>& files) {
   for (const ResultFile& f : files) {
     Statement s(
@@ -368,6 +375,7 @@ ClaimState SqliteStore::finish(const Claim& claim, const JobEnd& end) {
   }
   clear_results(db, claim.job_id);
   insert_results(db, claim.job_id, end.files);
+  clear_checkpoint(db, claim.job_id);
   tx.commit();
   return ClaimState::held;
 }
@@ -400,6 +408,7 @@ std::optional<JobRecord> SqliteStore::cancel(const std::string& id) {
                       "WHERE id = ?2");
   s.bind(1, now_text()).bind(2, id);
   s.step();
+  clear_checkpoint(db, id);
   tx.commit();
   return before;
 }
@@ -420,6 +429,7 @@ std::optional<JobRecord> SqliteStore::dismiss(const std::string& id) {
     s.step();
   }
   clear_results(db, id);
+  clear_checkpoint(db, id);
   tx.commit();
   return before;
 }
@@ -509,6 +519,7 @@ RecoveryReport SqliteStore::recover(int max_attempts, double charge_after_s) {
                           "charged = ?4 WHERE id = ?3");
       s.bind(1, reason).bind(2, now).bind(3, job.id).bind(4, static_cast<std::int64_t>(charged));
       s.step();
+      clear_checkpoint(db, job.id);
       report.failed.push_back(job.id);
     }
   }
@@ -543,12 +554,46 @@ std::vector<std::string> SqliteStore::purge_ended(
     s.bind(1, cutoff);
     while (s.step()) ids.push_back(s.text(0));
   }
-  for (const std::string& id : ids) clear_results(db, id);
+  for (const std::string& id : ids) {
+    clear_results(db, id);
+    clear_checkpoint(db, id);
+  }
   Statement s(db, "DELETE FROM jobs WHERE " + ended);
   s.bind(1, cutoff);
   s.step();
   tx.commit();
   return ids;
+}
+
+ClaimState SqliteStore::record_checkpoint(const Claim& claim, const CheckpointRecord& checkpoint) {
+  auto connection = pool_.lease();
+  sqlite3* db = connection.get();
+  WriteTransaction tx(db);
+  {
+    Statement s(db, "UPDATE jobs SET updated = ?4 WHERE " + claim_held);
+    bind_claim(s, claim);
+    s.bind(4, now_text());
+    s.step();
+    if (sqlite3_changes(db) != 1) return claim_state(db, claim);
+  }
+  Statement s(db,
+              "INSERT OR REPLACE INTO checkpoints (job_id, file, step, time, size, sha256, "
+              "written) VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7)");
+  s.bind(1, claim.job_id).bind(2, checkpoint.file).bind(3, checkpoint.step);
+  s.bind(4, checkpoint.time).bind(5, checkpoint.size).bind(6, checkpoint.sha256);
+  s.bind(7, checkpoint.written.empty() ? now_text() : checkpoint.written);
+  s.step();
+  tx.commit();
+  return ClaimState::held;
+}
+
+std::optional<CheckpointRecord> SqliteStore::checkpoint(const std::string& id) {
+  auto db = pool_.lease();
+  Statement s(db.get(),
+              "SELECT file, step, time, size, sha256, written FROM checkpoints WHERE job_id = ?1");
+  s.bind(1, id);
+  if (!s.step()) return std::nullopt;
+  return CheckpointRecord{s.text(0), s.integer(1), s.real(2), s.integer(3), s.text(4), s.text(5)};
 }
 
 }  // namespace hmpm::server::sqlite
