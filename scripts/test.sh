@@ -4,6 +4,9 @@
 # (clang-tidy), runs every C++ test (ctest), every Python test and the
 # dashboard's browser tests (headless Chromium with Debian's chromium-driver
 # and python3-selenium, which install-deps.sh installs; about 25 s).
+# The C++ and Python tests run against a throw-away PostgreSQL that
+# scripts/postgres.sh starts (initdb in a temporary folder, a free port of
+# 127.0.0.1) and stops at the end; its URI is HMPM_TEST_POSTGRES.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install-deps.sh
@@ -12,6 +15,10 @@ jobs=$(nproc 2>/dev/null || echo 2)
 status=0
 bash scripts/check_format.sh || status=1
 bash scripts/check_tidy.sh || status=1
+pg_dir=$(mktemp -d /tmp/hmpm-pg.XXXXXX)
+trap 'bash scripts/postgres.sh stop "$pg_dir"' EXIT
+HMPM_TEST_POSTGRES=$(bash scripts/postgres.sh start "$pg_dir")
+export HMPM_TEST_POSTGRES
 (cd build && ctest --output-on-failure -j "$jobs" --timeout 600) || status=1
 py=$(bash scripts/python.sh)
 if [ -d tests/python ] && ls tests/python/test_*.py >/dev/null 2>&1; then

@@ -13,12 +13,16 @@
 namespace hmpm::server::testing {
 
 void StoreContract::SetUp() {
+  if (GetParam().unavailable) {
+    if (const std::string reason = GetParam().unavailable(); !reason.empty())
+      GTEST_SKIP() << reason;
+  }
   scratch_ = make_temp_dir("store-" + GetParam().name);
 }
 
 void StoreContract::TearDown() {
   store_.reset();
-  std::filesystem::remove_all(scratch_);
+  if (!scratch_.empty()) std::filesystem::remove_all(scratch_);
 }
 
 JobStore& StoreContract::store() {

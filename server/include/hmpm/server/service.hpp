@@ -22,15 +22,19 @@ namespace hmpm::server {
 
 struct ServiceConfig {
   std::string host = "127.0.0.1";
-  int port = 8080;                 ///< 0: any free port
-  std::filesystem::path db_path;   ///< SQLite file (created if missing)
-  std::filesystem::path data_dir;  ///< result files; empty: <db dir>/results
-  int workers = 1;                 ///< jobs run at the same time
-  int threads_per_job = 0;         ///< solver threads per job; <= 0: cores / workers
-  std::string token;               ///< non-empty: Bearer token required (not on /health)
-  long max_queue = 1000;           ///< accepted jobs before POST /jobs answers 503
-  double job_wall_time_s = 0.0;    ///< per-job wall-clock limit; <= 0: none
-  int max_attempts = 3;            ///< starts of one job before restart recovery fails it
+  int port = 8080;  ///< 0: any free port
+  /// SQLite file (created if missing), or a PostgreSQL libpq URI
+  /// (postgresql://...; see is_postgres_uri in store.hpp).
+  std::filesystem::path db_path;
+  /// Result files; empty: <db dir>/results (SQLite only). With PostgreSQL it
+  /// is shared by every server on the database, and not locked.
+  std::filesystem::path data_dir;
+  int workers = 1;               ///< jobs run at the same time
+  int threads_per_job = 0;       ///< solver threads per job; <= 0: cores / workers
+  std::string token;             ///< non-empty: Bearer token required (not on /health)
+  long max_queue = 1000;         ///< accepted jobs before POST /jobs answers 503
+  double job_wall_time_s = 0.0;  ///< per-job wall-clock limit; <= 0: none
+  int max_attempts = 3;          ///< starts of one job before restart recovery fails it
   std::size_t max_body_bytes = std::size_t{16} << 20;  ///< request body limit (413)
   int max_event_streams = 8;           ///< concurrent GET /jobs/{id}/events (503 beyond)
   int http_threads = 24;               ///< connections served at once
@@ -49,9 +53,11 @@ struct ServiceConfig {
 class Service {
  public:
   /// Creates and locks the data folder, opens and locks the database and
-  /// recovers interrupted jobs. Throws hmpm::server::StoreFailure if the
-  /// database cannot be opened, or another process holds it or the data
-  /// folder (the message names its pid).
+  /// recovers interrupted jobs. With PostgreSQL neither is locked (servers
+  /// share both) and only jobs whose lease lapsed are recovered, here and
+  /// at every heartbeat. Throws hmpm::server::StoreFailure if the database
+  /// cannot be opened, or another process holds it or the data folder (the
+  /// message names its pid).
   explicit Service(ServiceConfig config);
   ~Service();
   Service(const Service&) = delete;

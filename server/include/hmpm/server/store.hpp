@@ -13,7 +13,8 @@
 // jobs of another live process.
 //
 // Backends: the SQLite store (`open_sqlite_store`, one process per file,
-// server/src/store/sqlite/); a shared PostgreSQL store can sit beside it.
+// server/src/store/sqlite/) and the PostgreSQL store (`open_postgres_store`,
+// any number of processes on one database, server/src/store/postgres/).
 // Every backend passes the contract suite in tests/server/store_contract.hpp.
 //
 // Domain outcomes (unknown job, queue full, idempotency conflict, lost claim)
@@ -159,6 +160,17 @@ struct JobEnd {
   double run_seconds = 0.0;
 };
 
+/// A running job's last checkpoint: the solver state after `step`, in
+/// `<data-dir>/<job id>/<file>`.
+struct CheckpointRecord {
+  std::string file;
+  std::int64_t step = 0;
+  double time = 0.0;  ///< simulated time, s
+  std::int64_t size = 0;
+  std::string sha256;
+  std::string written;  ///< RFC 3339 UTC
+};
+
 class JobStore {
  public:
   virtual ~JobStore() = default;
@@ -235,6 +247,14 @@ class JobStore {
   /// purged, however old. A purged id is unknown from then on (find: nullopt).
   virtual std::vector<std::string> purge_ended(
       std::chrono::system_clock::time_point ended_before) = 0;
+
+  /// Records the checkpoint a running job just wrote (its file under the
+  /// job's data folder, named by the claim's token so a stale writer never
+  /// overwrites the current one). held: recorded; dismissed/lost as for
+  /// update_progress (the file is then the caller's to remove).
+  virtual ClaimState record_checkpoint(const Claim& claim, const CheckpointRecord& checkpoint) = 0;
+  /// The job's last recorded checkpoint, if any (cleared when the job ends).
+  virtual std::optional<CheckpointRecord> checkpoint(const std::string& id) = 0;
 };
 
 /// Opens (creating if needed) the SQLite database at `db_path` for this
@@ -246,5 +266,18 @@ class JobStore {
 /// `clock` is the store's time (empty: the system clock).
 std::unique_ptr<JobStore> open_sqlite_store(const std::filesystem::path& db_path,
                                             WallClock clock = {});
+
+/// True when `db` names a PostgreSQL database (a libpq URI: postgresql://
+/// or postgres://) rather than a SQLite file.
+bool is_postgres_uri(std::string_view db);
+
+/// Connects to the PostgreSQL database of the libpq URI `uri` and migrates
+/// it to the current schema (concurrent servers migrate one at a time).
+/// Any number of processes may share the database: each claims with its own
+/// Claimant, and recover() takes only the jobs whose lease has lapsed.
+/// Timestamps and leases come from `clock` (empty: the system clock), so
+/// the servers' clocks must agree to well under a lease (NTP). Throws
+/// StoreFailure when it cannot connect or the schema is newer than this build.
+std::unique_ptr<JobStore> open_postgres_store(const std::string& uri, WallClock clock = {});
 
 }  // namespace hmpm::server

@@ -441,6 +441,16 @@ std::vector<std::string> SqliteStore::purge_ended(
   return ids;
 }
 
+// Checkpoints of the SQLite store come with the checkpoint work (a separate
+// branch); this build only has them in the PostgreSQL store.
+ClaimState SqliteStore::record_checkpoint(const Claim&, const CheckpointRecord&) {
+  throw StoreFailure("checkpoints: not in this build");
+}
+
+std::optional<CheckpointRecord> SqliteStore::checkpoint(const std::string&) {
+  throw StoreFailure("checkpoints: not in this build");
+}
+
 }  // namespace hmpm::server::sqlite
 
 namespace hmpm::server {

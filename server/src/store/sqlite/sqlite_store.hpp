@@ -41,6 +41,8 @@ class SqliteStore final : public JobStore {
   RecoveryReport recover(int max_attempts) override;
   StatusCounts count_by_status() override;
   std::vector<std::string> purge_ended(std::chrono::system_clock::time_point ended_before) override;
+  ClaimState record_checkpoint(const Claim& claim, const CheckpointRecord& checkpoint) override;
+  std::optional<CheckpointRecord> checkpoint(const std::string& id) override;
 
  private:
   std::chrono::system_clock::time_point now() const;
