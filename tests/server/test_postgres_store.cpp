@@ -210,7 +210,7 @@ TEST_F(PostgresStoreTest, CheckpointsSurviveRequeueAndRecoveryAndEndWithTheJob) 
   const auto id = store->submit(job("checkpointed"), 10).job.id;
   EXPECT_FALSE(store->checkpoint(id));
   Claim claim = claim_of(*store->claim_next(Claimant{"a", 600.0}));
-  const CheckpointRecord written{"checkpoint-1.bin", 120, 0.25, 4096, std::string(64, 'c'),
+  const CheckpointRecord written{"checkpoint-1.bin",        120, 0.25, 4096, std::string(64, 'c'),
                                  "2026-12-02T10:00:00.000Z"};
   EXPECT_EQ(store->record_checkpoint(claim, written), ClaimState::held);
   auto read = store->checkpoint(id);

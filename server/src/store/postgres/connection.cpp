@@ -76,8 +76,8 @@ std::string Result::sqlstate() const {
 
 Result exec(PGconn* db, const std::string& sql, const Params& params) {
   const auto values = params.pointers();
-  Result result(PQexecParams(db, sql.c_str(), params.size(), nullptr, values.data(), nullptr,
-                             nullptr, 0));
+  Result result(
+      PQexecParams(db, sql.c_str(), params.size(), nullptr, values.data(), nullptr, nullptr, 0));
   if (result.status() != PGRES_COMMAND_OK && result.status() != PGRES_TUPLES_OK) {
     fail(db, sql.substr(0, sql.find(' ')));
   }
@@ -86,8 +86,7 @@ Result exec(PGconn* db, const std::string& sql, const Params& params) {
 
 void exec_script(PGconn* db, const char* sql) {
   const Result result(PQexec(db, sql));
-  if (result.status() != PGRES_COMMAND_OK && result.status() != PGRES_TUPLES_OK)
-    fail(db, "script");
+  if (result.status() != PGRES_COMMAND_OK && result.status() != PGRES_TUPLES_OK) fail(db, "script");
 }
 
 Transaction::Transaction(PGconn* db) : db_(db) {

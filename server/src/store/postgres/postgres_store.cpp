@@ -61,9 +61,9 @@ JobRecord read_job(const Result& r, int row) {
   job.updated = text();
   job.attempts = static_cast<int>(integer());
   job.failure_reason = text();
-  for (std::int64_t* cost : {&job.cost.particles, &job.cost.nodes, &job.cost.cells,
-                             &job.cost.steps, &job.cost.particle_steps, &job.cost.memory_bytes,
-                             &job.cost.output_bytes}) {
+  for (std::int64_t* cost :
+       {&job.cost.particles, &job.cost.nodes, &job.cost.cells, &job.cost.steps,
+        &job.cost.particle_steps, &job.cost.memory_bytes, &job.cost.output_bytes}) {
     *cost = integer();
   }
   job.cost.dt = real();
@@ -110,8 +110,7 @@ void end_attempt(PGconn* db, const Claim& claim, const char* outcome, const std:
 
 // Ends every open attempt row of job `id` (dismissal, recovery).
 void end_attempts(PGconn* db, const std::string& id, const char* outcome, const std::string& now) {
-  exec(db,
-       "UPDATE job_attempts SET ended = $2, outcome = $3 WHERE job_id = $1 AND ended IS NULL",
+  exec(db, "UPDATE job_attempts SET ended = $2, outcome = $3 WHERE job_id = $1 AND ended IS NULL",
        Params().add(id).add(now).add(outcome));
 }
 
@@ -179,15 +178,15 @@ SubmitResult PostgresStore::submit(const NewJob& job, std::int64_t max_queue) {
   p.add(job.cost.particles).add(job.cost.nodes).add(job.cost.cells).add(job.cost.steps);
   p.add(job.cost.particle_steps).add(job.cost.memory_bytes).add(job.cost.output_bytes);
   p.add(job.cost.dt);
-  const Result r = exec(
-      db,
-      "INSERT INTO jobs (id, name, spec, status, message, created, updated, idempotency_key, "
-      "body_sha256, cost_particles, cost_nodes, cost_cells, cost_steps, cost_particle_steps, "
-      "cost_memory_bytes, cost_output_bytes, cost_dt) VALUES ($1, $2, $3, " +
-          sql_name(JobStatus::accepted) +
-          ", 'queued', $4, $4, $5, $6, $7, $8, $9, $10, $11, $12, $13, $14) RETURNING " +
-          job_columns,
-      p);
+  const Result r =
+      exec(db,
+           "INSERT INTO jobs (id, name, spec, status, message, created, updated, idempotency_key, "
+           "body_sha256, cost_particles, cost_nodes, cost_cells, cost_steps, cost_particle_steps, "
+           "cost_memory_bytes, cost_output_bytes, cost_dt) VALUES ($1, $2, $3, " +
+               sql_name(JobStatus::accepted) +
+               ", 'queued', $4, $4, $5, $6, $7, $8, $9, $10, $11, $12, $13, $14) RETURNING " +
+               job_columns,
+           p);
   JobRecord created = read_job(r, 0);
   tx.commit();
   return {SubmitOutcome::created, std::move(created)};
@@ -222,9 +221,9 @@ std::vector<JobRecord> PostgresStore::list(const std::vector<JobStatus>& statuse
 std::vector<std::string> PostgresStore::ids_with_prefix(const std::string& prefix, int limit) {
   auto db = pool_.lease();
   // left(), not LIKE: the prefix is matched as text, whatever it holds.
-  const Result r = exec(db.get(),
-                        "SELECT id FROM jobs WHERE left(id, length($1)) = $1 ORDER BY seq LIMIT $2",
-                        Params().add(prefix).add(std::int64_t{limit}));
+  const Result r =
+      exec(db.get(), "SELECT id FROM jobs WHERE left(id, length($1)) = $1 ORDER BY seq LIMIT $2",
+           Params().add(prefix).add(std::int64_t{limit}));
   std::vector<std::string> out;
   for (int i = 0; i < r.rows(); ++i) out.push_back(r.text(i, 0));
   return out;
@@ -237,15 +236,15 @@ std::optional<JobRecord> PostgresStore::claim_next(const Claimant& who) {
   const std::string now = now_text();
   // SKIP LOCKED: a row another server is claiming right now is passed over,
   // not waited for; the next accepted one is taken instead.
-  const Result r = exec(
-      db,
-      "UPDATE jobs SET status = " + sql_name(JobStatus::running) +
-          ", progress = 0, message = 'running', started = $1, finished = NULL, updated = $1, "
-          "attempts = attempts + 1, owner = $2, lease_token = lease_token + 1, "
-          "lease_expires_ms = $3 WHERE id = (SELECT id FROM jobs WHERE status = " +
-          sql_name(JobStatus::accepted) +
-          " ORDER BY seq LIMIT 1 FOR UPDATE SKIP LOCKED) RETURNING " + job_columns,
-      Params().add(now).add(who.instance).add(lease_until(who)));
+  const Result r =
+      exec(db,
+           "UPDATE jobs SET status = " + sql_name(JobStatus::running) +
+               ", progress = 0, message = 'running', started = $1, finished = NULL, updated = $1, "
+               "attempts = attempts + 1, owner = $2, lease_token = lease_token + 1, "
+               "lease_expires_ms = $3 WHERE id = (SELECT id FROM jobs WHERE status = " +
+               sql_name(JobStatus::accepted) +
+               " ORDER BY seq LIMIT 1 FOR UPDATE SKIP LOCKED) RETURNING " + job_columns,
+           Params().add(now).add(who.instance).add(lease_until(who)));
   if (r.rows() == 0) return std::nullopt;
   JobRecord job = read_job(r, 0);
   exec(db, "INSERT INTO job_attempts (job_id, token, owner, claimed) VALUES ($1, $2, $3, $4)",
@@ -322,8 +321,8 @@ std::optional<JobRecord> PostgresStore::cancel(const std::string& id) {
   const std::string now = now_text();
   exec(db,
        "UPDATE jobs SET status = " + sql_name(JobStatus::dismissed) +
-           ", message = 'cancelled by the client', finished = $1, updated = $1, " +
-           no_checkpoint + " WHERE id = $2",
+           ", message = 'cancelled by the client', finished = $1, updated = $1, " + no_checkpoint +
+           " WHERE id = $2",
        Params().add(now).add(id));
   end_attempts(db, id, status_name(JobStatus::dismissed), now);
   tx.commit();
@@ -371,10 +370,10 @@ ClaimState PostgresStore::keep_results(const Claim& claim, const std::vector<Res
 
 std::vector<ResultFile> PostgresStore::results(const std::string& id) {
   auto db = pool_.lease();
-  const Result r = exec(
-      db.get(),
-      "SELECT name, size, sha256, media_type FROM results WHERE job_id = $1 ORDER BY name",
-      Params().add(id));
+  const Result r =
+      exec(db.get(),
+           "SELECT name, size, sha256, media_type FROM results WHERE job_id = $1 ORDER BY name",
+           Params().add(id));
   std::vector<ResultFile> out;
   for (int i = 0; i < r.rows(); ++i)
     out.push_back({r.text(i, 0), r.integer(i, 1), r.text(i, 2), r.text(i, 3)});
@@ -471,8 +470,8 @@ std::optional<CheckpointRecord> PostgresStore::checkpoint(const std::string& id)
                         "WHERE id = $1 AND checkpoint_file IS NOT NULL",
                         Params().add(id));
   if (r.rows() == 0) return std::nullopt;
-  return CheckpointRecord{r.text(0, 0), r.integer(0, 1), r.real(0, 2),
-                          r.integer(0, 3), r.text(0, 4), r.text(0, 5)};
+  return CheckpointRecord{r.text(0, 0),    r.integer(0, 1), r.real(0, 2),
+                          r.integer(0, 3), r.text(0, 4),    r.text(0, 5)};
 }
 
 }  // namespace hmpm::server::postgres
