@@ -144,6 +144,7 @@ TEST_F(PostgresStoreTest, ManyServersClaimingAtOnceNeverShareAJob) {
   constexpr int threads_per_server = 3;
   constexpr int jobs = 120;
   std::vector<std::unique_ptr<JobStore>> stores;
+  stores.reserve(servers);
   for (int i = 0; i < servers; ++i) stores.push_back(open_postgres_store(uri_));
   for (int i = 0; i < jobs; ++i) {
     std::string id = "j-";  // (not "j-" + ...: GCC 12 warns falsely, -Wrestrict)

@@ -225,6 +225,7 @@ std::vector<std::string> PostgresStore::ids_with_prefix(const std::string& prefi
       exec(db.get(), "SELECT id FROM jobs WHERE left(id, length($1)) = $1 ORDER BY seq LIMIT $2",
            Params().add(prefix).add(std::int64_t{limit}));
   std::vector<std::string> out;
+  out.reserve(static_cast<std::size_t>(r.rows()));
   for (int i = 0; i < r.rows(); ++i) out.push_back(r.text(i, 0));
   return out;
 }
@@ -375,6 +376,7 @@ std::vector<ResultFile> PostgresStore::results(const std::string& id) {
            "SELECT name, size, sha256, media_type FROM results WHERE job_id = $1 ORDER BY name",
            Params().add(id));
   std::vector<ResultFile> out;
+  out.reserve(static_cast<std::size_t>(r.rows()));
   for (int i = 0; i < r.rows(); ++i)
     out.push_back({r.text(i, 0), r.integer(i, 1), r.text(i, 2), r.text(i, 3)});
   return out;
@@ -441,6 +443,7 @@ std::vector<std::string> PostgresStore::purge_ended(
                             "SELECT id FROM gone ORDER BY seq",
                         Params().add(format_rfc3339(ended_before)));
   std::vector<std::string> ids;
+  ids.reserve(static_cast<std::size_t>(r.rows()));
   for (int i = 0; i < r.rows(); ++i) ids.push_back(r.text(i, 0));
   return ids;
 }
