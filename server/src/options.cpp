@@ -1,6 +1,8 @@
 // options.cpp — see options.hpp.
 #include "hmpm/server/options.hpp"
 
+#include "hmpm/server/store.hpp"
+
 #include <charconv>
 #include <cmath>
 #include <functional>
@@ -34,17 +36,21 @@ bool parse_seconds(const std::string& text, double& out) {
 }  // namespace
 
 std::string usage() {
-  return "usage: hmpm-server [--host H] [--port P] --db PATH [--workers N] [--data-dir DIR]\n"
+  return "usage: hmpm-server [--host H] [--port P] --db PATH|URI [--workers N] [--data-dir DIR]\n"
          "                   [--threads-per-job N] [--token T] [--max-queue N]\n"
          "                   [--job-wall-time S] [--max-particles N] [--max-particle-steps N]\n"
          "                   [--max-job-memory B] [--max-attempts N] [--charge-after S]\n"
          "                   [--max-body-bytes N]\n"
          "                   [--max-event-streams N] [--http-threads N] [--retain-days N]\n"
-         "                   [--checkpoint-interval S]\n"
+         "                   [--checkpoint-interval S] [--lease-seconds S]\n"
          "  --host H              address to listen on (default 127.0.0.1)\n"
          "  --port P              port; 0 picks a free one (default 8080)\n"
-         "  --db PATH             SQLite database, created if missing (required)\n"
-         "  --data-dir DIR        result files (default: <db dir>/results)\n"
+         "  --db PATH             SQLite database, created if missing, for this process alone\n"
+         "  --db postgresql://USER@HOST:PORT/DBNAME\n"
+         "                        PostgreSQL database (a libpq URI) that any number of servers\n"
+         "                        share; then --data-dir is required (one folder all of them\n"
+         "                        read and write)\n"
+         "  --data-dir DIR        result files (default with SQLite: <db dir>/results)\n"
          "  --workers N           jobs run at the same time (default 1)\n"
          "  --threads-per-job N   solver threads per job (default: cores / workers)\n"
          "  --token T             require 'Authorization: Bearer T' (default: $HMPM_TOKEN)\n"
@@ -68,6 +74,9 @@ std::string usage() {
          "  --checkpoint-interval S  checkpoint a running job every S seconds of wall time; a\n"
          "                        job interrupted by a crash resumes from its last checkpoint;\n"
          "                        0 turns checkpoints off (default 60)\n"
+         "  --lease-seconds S     a running job's claim lapses S s after its server's last\n"
+         "                        heartbeat (every S/3 s); then another server takes it over\n"
+         "                        (default 30)\n"
          "The first line on stdout is 'listening on http://HOST:PORT'. SIGTERM or SIGINT\n"
          "stops accepting, puts running jobs back in the queue and exits 0.\n";
 }
@@ -146,6 +155,14 @@ ParsedOptions parse_options(const std::vector<std::string>& args, const char* en
        }},
       {"--retain-days",
        integer(0, 100'000, [&](long n) { config.retain_days = static_cast<int>(n); })},
+      {"--lease-seconds",
+       [&](const std::string& v) {
+         // At least 1 s: the heartbeat renews every third of it and a
+         // database round trip must fit in between.
+         return parse_seconds(v, config.lease_s) && config.lease_s >= 1.0
+                    ? std::string()
+                    : std::string("must be seconds >= 1");
+       }},
   };
 
   for (std::size_t i = 0; i < args.size(); ++i) {
@@ -181,6 +198,12 @@ ParsedOptions parse_options(const std::vector<std::string>& args, const char* en
   }
   if (config.db_path.empty()) {
     result.error = "--db PATH is required";
+    return result;
+  }
+  if (is_postgres_uri(config.db_path.string()) && config.data_dir.empty()) {
+    result.error =
+        "--data-dir DIR is required with a PostgreSQL --db (the folder every server "
+        "sharing the database reads and writes)";
     return result;
   }
   if (config.host.empty()) {

@@ -1,13 +1,17 @@
 // service.cpp — the life cycle of hmpm-server: open, lock, recover, bind, serve, stop.
 //
-// Construction takes the data folder's lock and opens the store (which locks
-// the database) before anything is recovered or bound, so a second server on
-// the same `--db` or `--data-dir` fails here with the other one's pid. Each
-// process is one store instance (`instance_id`): its claims carry that id,
-// its heartbeat renews their leases. Requests are served by http/.
+// With SQLite, construction takes the data folder's lock and opens the store
+// (which locks the database) before anything is recovered or bound, so a
+// second server on the same `--db` or `--data-dir` fails here with the other
+// one's pid. With PostgreSQL (`--db postgresql://...`) neither is locked:
+// servers share the database and the data folder, and the claims keep them
+// apart. Each process is one store instance (`instance_id`): its claims carry
+// that id, its heartbeat renews their leases and takes over lapsed ones
+// (worker_pool.hpp). Requests are served by http/.
 #include <chrono>
 #include <condition_variable>
 #include <mutex>
+#include <optional>
 #include <thread>
 #include <utility>
 
@@ -22,6 +26,7 @@
 #include "metrics.hpp"
 #include "process_lock.hpp"
 #include "retention.hpp"
+#include "store/postgres/connection.hpp"
 #include "worker_pool.hpp"
 
 namespace hmpm::server {
@@ -30,15 +35,23 @@ namespace {
 using SteadyClock = std::chrono::steady_clock;
 
 // Fills in the defaults that depend on other settings and creates folders.
+bool on_postgres(const ServiceConfig& c) {
+  return is_postgres_uri(c.db_path.string());
+}
+
 ServiceConfig resolved(ServiceConfig c) {
-  if (c.data_dir.empty()) c.data_dir = c.db_path.parent_path() / "results";
   if (c.threads_per_job <= 0) {
     const int cores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
     c.threads_per_job = std::max(1, cores / std::max(1, c.workers));
   }
   if (c.max_job_memory == 0) c.max_job_memory = default_job_memory(c.workers);
-  if (!c.db_path.parent_path().empty())
-    std::filesystem::create_directories(c.db_path.parent_path());
+  if (on_postgres(c)) {
+    if (c.data_dir.empty()) throw StoreFailure("--data-dir is required with a PostgreSQL database");
+  } else {
+    if (c.data_dir.empty()) c.data_dir = c.db_path.parent_path() / "results";
+    if (!c.db_path.parent_path().empty())
+      std::filesystem::create_directories(c.db_path.parent_path());
+  }
   std::filesystem::create_directories(c.data_dir);
   return c;
 }
@@ -60,7 +73,9 @@ WorkerSettings worker_settings(const ServiceConfig& c, const hmpm::api::Limits& 
                         .limits = limits,
                         .claimant = Claimant{instance, c.lease_s},
                         .lease_renewal_s = c.lease_s / 3.0,
-                        .checkpoint_interval_s = c.checkpoint_interval_s};
+                        .checkpoint_interval_s = c.checkpoint_interval_s,
+                        .max_attempts = c.max_attempts,
+                        .charge_after_s = c.charge_after_s};
 }
 
 // Validations running at once: half the cores (at least one), so the
@@ -93,21 +108,33 @@ void log_recovery(const RecoveryReport& recovery) {
 struct Service::Impl {
   explicit Impl(ServiceConfig c)
       : config(resolved(std::move(c))),
-        data_lock(ProcessLock::hold(config.data_dir / ".hmpm-server.lock",
-                                    "data folder " + config.data_dir.string())),
+        data_lock(lock_data_dir(config)),
         limits(limits_for(config)),
-        store(open_sqlite_store(config.db_path)),
+        store(open_store(config)),
         workers(*store, metrics, worker_settings(config, limits, instance_id)),
         validation(validation_turns(), std::max(2, config.http_threads / 4), validation_wait_s),
         context{config, limits, *store, metrics, workers, stopping, validation},
         auth(config.token),
         router(http::route_table(), context, auth) {
+    metrics.instance = instance_id;
     log_recovery(store->recover(config.max_attempts, config.charge_after_s));
     http::configure_server(server, context, router, auth);
   }
 
+  // SQLite: one process per data folder. PostgreSQL: the folder is shared.
+  static std::optional<ProcessLock> lock_data_dir(const ServiceConfig& c) {
+    if (on_postgres(c)) return std::nullopt;
+    return ProcessLock::hold(c.data_dir / ".hmpm-server.lock",
+                             "data folder " + c.data_dir.string());
+  }
+  static std::unique_ptr<JobStore> open_store(const ServiceConfig& c) {
+    if (on_postgres(c)) return open_postgres_store(c.db_path.string());
+    return open_sqlite_store(c.db_path);
+  }
+
   ServiceConfig config;
-  ProcessLock data_lock;  ///< before the store: nothing is opened unless both locks are ours
+  /// Before the store: nothing is opened unless both locks are ours (SQLite).
+  std::optional<ProcessLock> data_lock;
   hmpm::api::Limits limits;
   std::string instance_id = new_uuid_v4();
   std::unique_ptr<JobStore> store;
@@ -187,7 +214,7 @@ bool Service::run() {
             {"workers", s.config.workers},
             {"threads_per_job", s.config.threads_per_job},
             {"seconds_per_particle_step", s.config.seconds_per_particle_step},
-            {"db", s.config.db_path.string()},
+            {"db", postgres::redacted(s.config.db_path.string())},
             {"data_dir", s.config.data_dir.string()},
             {"instance", s.instance_id},
             {"auth", !s.config.token.empty()},

@@ -178,6 +178,27 @@ std::optional<std::string> record_files(const std::filesystem::path& dir,
 
 }  // namespace
 
+void log_recovery(const RecoveryReport& recovery) {
+  for (const auto& id : recovery.requeued) {
+    log_line({{"event", "job"},
+              {"job", id},
+              {"status", status_name(JobStatus::accepted)},
+              {"recovered", true}});
+  }
+  for (const auto& id : recovery.failed) {
+    log_line({{"event", "job"},
+              {"job", id},
+              {"status", status_name(JobStatus::failed)},
+              {"recovered", true},
+              {"reason", "too many interrupted attempts"}});
+  }
+}
+
+void WorkerPool::claim_lost(const std::string& id, double seconds) {
+  ++metrics_.claims_lost;
+  log_line({{"event", "job"}, {"job", id}, {"claim", "lost"}, {"seconds", seconds}});
+}
+
 void WorkerPool::end_dismissed(const JobRecord& job, const Claim& claim,
                                const std::vector<std::string>& written, double seconds) {
   const std::filesystem::path dir = job_dir(job.id);
@@ -191,7 +212,7 @@ void WorkerPool::end_dismissed(const JobRecord& job, const Claim& claim,
     log_line({{"event", "store_error"}, {"job", job.id}, {"detail", e.what()}});
   }
   if (state == ClaimState::lost) {  // not ours any more: touch nothing
-    log_line({{"event", "job"}, {"job", job.id}, {"claim", "lost"}, {"seconds", seconds}});
+    claim_lost(job.id, seconds);
     return;
   }
   const bool kept = state == ClaimState::held;
@@ -230,12 +251,22 @@ void WorkerPool::heartbeat() {
     heartbeat_wake_.wait_for(lock, std::chrono::duration<double>(settings_.lease_renewal_s),
                              [&] { return stopping_; });
     if (stopping_) return;
-    if (running_.empty()) continue;
+    const bool busy = !running_.empty();
     lock.unlock();
     try {
-      store_.renew_leases(settings_.claimant);
+      if (busy) store_.renew_leases(settings_.claimant);
     } catch (const std::exception& e) {
       log_line({{"event", "store_error"}, {"detail", e.what()}, {"during", "lease renewal"}});
+    }
+    try {
+      // Takes over the jobs of servers whose lease lapsed (on one SQLite
+      // file there are none: the lock voided them at start-up).
+      const RecoveryReport report = store_.recover(settings_.max_attempts, settings_.charge_after_s);
+      log_recovery(report);
+      metrics_.recovered_jobs += static_cast<int>(report.requeued.size() + report.failed.size());
+      for (std::size_t i = 0; i < report.requeued.size(); ++i) notify();
+    } catch (const std::exception& e) {
+      log_line({{"event", "store_error"}, {"detail", e.what()}, {"during", "recovery"}});
     }
     lock.lock();
   }
@@ -497,7 +528,7 @@ void WorkerPool::run_one(const JobRecord& job, Running& running) {
   const double seconds = seconds_since(t0);
 
   if (running.lost) {  // another instance owns the job and its folder now
-    log_line({{"event", "job"}, {"job", job.id}, {"claim", "lost"}, {"seconds", seconds}});
+    claim_lost(job.id, seconds);
     return;
   }
   if (running.dismissed) {
@@ -508,7 +539,7 @@ void WorkerPool::run_one(const JobRecord& job, Running& running) {
     const ClaimState state = with_retries(job.id, "requeue", [&] { return store_.requeue(claim); });
     if (state == ClaimState::dismissed) return end_dismissed(job, claim, result.files, seconds);
     if (state == ClaimState::lost) {
-      log_line({{"event", "job"}, {"job", job.id}, {"claim", "lost"}, {"seconds", seconds}});
+      claim_lost(job.id, seconds);
       return;
     }
     if (checkpoint_file.empty()) {
@@ -537,7 +568,7 @@ void WorkerPool::run_one(const JobRecord& job, Running& running) {
     return store_.finish(claim, JobEnd{outcome, message, reason, files, seconds});
   });
   if (state == ClaimState::lost) {  // taken over while finishing: the files are not ours
-    log_line({{"event", "job"}, {"job", job.id}, {"claim", "lost"}, {"seconds", seconds}});
+    claim_lost(job.id, seconds);
     return;
   }
   if (state == ClaimState::dismissed) return end_dismissed(job, claim, result.files, seconds);

@@ -15,7 +15,10 @@
 // Every job is claimed for this process's instance (`WorkerSettings::claimant`);
 // a heartbeat thread renews the leases of the running jobs every
 // `lease_renewal_s`, and a worker whose claim was lost stops without touching
-// the job's files (another instance owns them now).
+// the job's files (another instance owns them now). The same heartbeat runs
+// recovery (JobStore::recover), so the jobs of a server that died while
+// others share its database are taken over once their lease lapses, not
+// only when a server starts.
 #pragma once
 
 #include <atomic>
@@ -48,7 +51,12 @@ struct WorkerSettings {
   /// Wall time between checkpoints of a running job (its solver state, from
   /// which a later attempt resumes); <= 0: none.
   double checkpoint_interval_s = 60.0;
+  int max_attempts = 3;           ///< recover(): starts of a job before it fails
+  double charge_after_s = 30.0;   ///< recover(): see ServiceConfig::charge_after_s
 };
+
+/// One log line per job that recovery requeued or failed.
+void log_recovery(const RecoveryReport& recovery);
 
 class WorkerPool {
  public:
@@ -82,6 +90,8 @@ class WorkerPool {
   void work();
   void heartbeat();
   void run_one(const JobRecord& job, Running& running);
+  // A write of `id` was refused: another claim replaced ours (counted, logged).
+  void claim_lost(const std::string& id, double seconds);
   // The end of a dismissed run: keeps the files it `written` if the job was
   // cancelled, removes them if it was deleted (the store decides).
   void end_dismissed(const JobRecord& job, const Claim& claim,

@@ -13,12 +13,16 @@
 namespace hmpm::server::testing {
 
 void StoreContract::SetUp() {
+  if (GetParam().unavailable) {
+    if (const std::string reason = GetParam().unavailable(); !reason.empty())
+      GTEST_SKIP() << reason;
+  }
   scratch_ = make_temp_dir("store-" + GetParam().name);
 }
 
 void StoreContract::TearDown() {
   store_.reset();
-  std::filesystem::remove_all(scratch_);
+  if (!scratch_.empty()) std::filesystem::remove_all(scratch_);
 }
 
 JobStore& StoreContract::store() {
@@ -475,7 +479,7 @@ TEST_P(StoreContract, CheckpointsAreFencedKeptForTheNextAttemptAndClearedAtTheEn
   EXPECT_EQ(store().checkpoint(id)->step, 20);
   EXPECT_EQ(store().record_checkpoint(second, checkpoint_at(40, second)), ClaimState::held);
   // Recovered after a crash: kept; the crashed claim's writes are refused.
-  ASSERT_EQ(store().recover(5).requeued.size(), 1u);
+  ASSERT_EQ(store().recover(5, 0.0).requeued.size(), 1u);
   EXPECT_EQ(store().checkpoint(id)->step, 40);
   const Claim third = claim_of(*store().claim_next(live()));
   EXPECT_EQ(store().record_checkpoint(second, checkpoint_at(50, second)), ClaimState::lost);
@@ -510,7 +514,7 @@ TEST_P(StoreContract, AJobFailedByRecoveryForgetsItsCheckpoint) {
   const auto id = store().submit(job("crashing"), 10).job.id;
   const Claim claim = claim_of(*store().claim_next(dead("crashed")));
   EXPECT_EQ(store().record_checkpoint(claim, checkpoint_at(5, claim)), ClaimState::held);
-  ASSERT_EQ(store().recover(1).failed.size(), 1u);  // attempts 1 >= max 1
+  ASSERT_EQ(store().recover(1, 0.0).failed.size(), 1u);  // attempts 1 >= max 1
   EXPECT_FALSE(store().checkpoint(id));
 }
 

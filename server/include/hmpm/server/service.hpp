@@ -22,13 +22,17 @@ namespace hmpm::server {
 
 struct ServiceConfig {
   std::string host = "127.0.0.1";
-  int port = 8080;                 ///< 0: any free port
-  std::filesystem::path db_path;   ///< SQLite file (created if missing)
-  std::filesystem::path data_dir;  ///< result files; empty: <db dir>/results
-  int workers = 1;                 ///< jobs run at the same time
-  int threads_per_job = 0;         ///< solver threads per job; <= 0: cores / workers
-  std::string token;               ///< non-empty: Bearer token required (not on /health)
-  long max_queue = 1000;           ///< accepted jobs before POST /jobs answers 503
+  int port = 8080;  ///< 0: any free port
+  /// SQLite file (created if missing), or a PostgreSQL libpq URI
+  /// (postgresql://...; see is_postgres_uri in store.hpp).
+  std::filesystem::path db_path;
+  /// Result files; empty: <db dir>/results (SQLite only). With PostgreSQL it
+  /// is shared by every server on the database, and not locked.
+  std::filesystem::path data_dir;
+  int workers = 1;               ///< jobs run at the same time
+  int threads_per_job = 0;       ///< solver threads per job; <= 0: cores / workers
+  std::string token;             ///< non-empty: Bearer token required (not on /health)
+  long max_queue = 1000;         ///< accepted jobs before POST /jobs answers 503
   /// Per-job wall-clock limit, set-up included; <= 0: none.
   double job_wall_time_s = 86'400.0;
   std::int64_t max_particles = 2'000'000;  ///< particles per job (the parser's budget)
@@ -67,9 +71,11 @@ struct ServiceConfig {
 class Service {
  public:
   /// Creates and locks the data folder, opens and locks the database and
-  /// recovers interrupted jobs. Throws hmpm::server::StoreFailure if the
-  /// database cannot be opened, or another process holds it or the data
-  /// folder (the message names its pid).
+  /// recovers interrupted jobs. With PostgreSQL neither is locked (servers
+  /// share both) and only jobs whose lease lapsed are recovered, here and
+  /// at every heartbeat. Throws hmpm::server::StoreFailure if the database
+  /// cannot be opened, or another process holds it or the data folder (the
+  /// message names its pid).
   explicit Service(ServiceConfig config);
   ~Service();
   Service(const Service&) = delete;

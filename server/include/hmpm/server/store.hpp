@@ -13,7 +13,8 @@
 // jobs of another live process.
 //
 // Backends: the SQLite store (`open_sqlite_store`, one process per file,
-// server/src/store/sqlite/); a shared PostgreSQL store can sit beside it.
+// server/src/store/sqlite/) and the PostgreSQL store (`open_postgres_store`,
+// any number of processes on one database, server/src/store/postgres/).
 // Every backend passes the contract suite in tests/server/store_contract.hpp.
 //
 // Domain outcomes (unknown job, queue full, idempotency conflict, lost claim)
@@ -284,5 +285,18 @@ class JobStore {
 /// `clock` is the store's time (empty: the system clock).
 std::unique_ptr<JobStore> open_sqlite_store(const std::filesystem::path& db_path,
                                             WallClock clock = {});
+
+/// True when `db` names a PostgreSQL database (a libpq URI: postgresql://
+/// or postgres://) rather than a SQLite file.
+bool is_postgres_uri(std::string_view db);
+
+/// Connects to the PostgreSQL database of the libpq URI `uri` and migrates
+/// it to the current schema (concurrent servers migrate one at a time).
+/// Any number of processes may share the database: each claims with its own
+/// Claimant, and recover() takes only the jobs whose lease has lapsed.
+/// Timestamps and leases come from `clock` (empty: the system clock), so
+/// the servers' clocks must agree to well under a lease (NTP). Throws
+/// StoreFailure when it cannot connect or the schema is newer than this build.
+std::unique_ptr<JobStore> open_postgres_store(const std::string& uri, WallClock clock = {});
 
 }  // namespace hmpm::server
