@@ -62,28 +62,40 @@ bool in_polygon_shape(const Body& body, const Vec3& x, double tol) {
   return geometry::inside_or_on(prism.polygon.vertices, {x[u], x[v]}, tol);
 }
 
+/// The bounding box of a polygon or prism body's shape (a box body: its box).
+Box shape_box(const Body& body) {
+  Box out = body.box;
+  if (!body.polygon && !body.prism) return out;
+  const std::vector<Point2>& poly =
+      body.polygon ? body.polygon->vertices : body.prism->polygon.vertices;
+  if (poly.empty()) return out;
+  const auto [lo, hi] = geometry::bounds(poly);
+  const std::array<int, 2> uv =
+      body.polygon ? std::array<int, 2>{0, 1} : plane_axes(body.prism->axis);
+  for (int k = 0; k < 2; ++k) {
+    out.min[uv[k]] = lo[k];
+    out.max[uv[k]] = hi[k];
+  }
+  if (body.prism) {
+    out.min[body.prism->axis] = body.prism->from;
+    out.max[body.prism->axis] = body.prism->to;
+  }
+  return out;
+}
+
+bool in_box(const Box& box, const Vec3& x, int dim, double tol) {
+  for (int a = 0; a < dim; ++a)
+    if (x[a] < box.min[a] - tol || x[a] > box.max[a] + tol) return false;
+  return true;
+}
+
 /// Per axis, the sub-cell centres a lattice body may fill: of the whole
 /// cells inside a box, or of every cell meeting a polygon's or prism's
 /// bounding box.
 std::array<std::vector<double>, 3> lattice_coords(const Problem& problem, const Body& body) {
   const int ppc = std::max(body.particles_per_cell, 1);
-  Box range = body.box;
+  const Box range = shape_box(body);
   const bool whole_cells = !body.polygon && !body.prism;
-  if (!whole_cells) {
-    const std::vector<Point2>& poly =
-        body.polygon ? body.polygon->vertices : body.prism->polygon.vertices;
-    const auto [lo, hi] = geometry::bounds(poly);
-    const std::array<int, 2> uv =
-        body.polygon ? std::array<int, 2>{0, 1} : plane_axes(body.prism->axis);
-    for (int k = 0; k < 2; ++k) {
-      range.min[uv[k]] = lo[k];
-      range.max[uv[k]] = hi[k];
-    }
-    if (body.prism) {
-      range.min[body.prism->axis] = body.prism->from;
-      range.max[body.prism->axis] = body.prism->to;
-    }
-  }
   std::array<std::vector<double>, 3> coords;
   for (int a = 0; a < 3; ++a) {
     if (a >= problem.dimension) {
@@ -107,15 +119,16 @@ std::array<std::vector<double>, 3> lattice_coords(const Problem& problem, const 
   return coords;
 }
 
-/// Whether an earlier box, polygon or prism body (its layout `earlier`)
-/// owns position x: a box owns the whole cells it fills.
-bool claims(const Problem& problem, const Body& body, const BodyLayout& earlier, const Vec3& x,
-            double tol) {
+/// Whether an earlier box, polygon or prism body (its layout `earlier`,
+/// its shape's bounding box `bounds`) owns position x: a box owns the whole
+/// cells it fills, a polygon or prism its shape.
+bool claims(const Problem& problem, const Body& body, const BodyLayout& earlier, const Box& bounds,
+            const Vec3& x, double tol) {
   if (earlier.count == 0) return false;
-  if (body.polygon || body.prism) return in_polygon_shape(body, x, tol);
-  for (int a = 0; a < problem.dimension; ++a)
-    if (x[a] < earlier.lo[a] - tol || x[a] > earlier.hi[a] + tol) return false;
-  return true;
+  if (body.polygon || body.prism)
+    return in_box(bounds, x, problem.dimension, tol) && in_polygon_shape(body, x, tol);
+  const Box filled{earlier.lo, earlier.hi};
+  return in_box(filled, x, problem.dimension, tol);
 }
 
 /// Whether two positions coincide (within tol per axis).
@@ -132,6 +145,8 @@ std::vector<BodyLayout> body_layouts(const Problem& problem) {
   const int dim = problem.dimension;
   // Every points body's positions sorted by x, to find coincident ones.
   std::vector<std::vector<Vec3>> sorted_points(problem.bodies.size());
+  std::vector<Box> bounds;
+  for (const Body& body : problem.bodies) bounds.push_back(shape_box(body));
   double cell_volume = 1.0;
   for (int a = 0; a < dim; ++a) cell_volume *= cell_size(problem, a);
   for (std::size_t b = 0; b < problem.bodies.size(); ++b) {
@@ -148,7 +163,7 @@ std::vector<BodyLayout> body_layouts(const Problem& problem) {
           for (; it != pts.end() && (*it)[0] <= x[0] + tol && !owned; ++it)
             owned = same_place(*it, x, tol);
         } else {
-          owned = claims(problem, problem.bodies[e], layouts[e], x, tol);
+          owned = claims(problem, problem.bodies[e], layouts[e], bounds[e], x, tol);
         }
         if (owned) {
           ++lost[e];

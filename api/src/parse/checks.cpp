@@ -16,6 +16,10 @@ namespace {
 constexpr double max_layout_work = 5e7;
 // Work bound for checks that visit every particle per selection.
 constexpr double max_near_work = 2e8;
+// Work bound for filling polygons and prisms: candidate positions x the
+// polygon's vertices (each laying out tests every candidate against every
+// edge; validation lays the bodies out a few times).
+constexpr double max_polygon_work = 2e8;
 
 /// The box a body's particles lie in: its box, or the bounding box of its
 /// polygon or prism (points bodies: unused).
@@ -85,6 +89,19 @@ bool check_particle_budget(ParseContext& c) {
         return false;
       }
       n *= along;
+    }
+    if (shaped) {
+      const std::size_t vertices =
+          body.polygon ? body.polygon->vertices.size() : body.prism->polygon.vertices.size();
+      if (n * static_cast<double>(vertices) > max_polygon_work) {
+        c.r.error(child_pointer("/bodies", b) + (body.polygon ? "/polygon" : "/prism/polygon"),
+                  "filling it tests " + format_count(n) + " sub-cell centres against " +
+                      std::to_string(vertices) + " edges, too much work (" +
+                      format_count(n * static_cast<double>(vertices)) + " > " +
+                      format_count(max_polygon_work) +
+                      "); use fewer vertices, fewer particles per cell or a coarser grid");
+        return false;
+      }
     }
     total += n;
   }
