@@ -72,41 +72,46 @@ template <int Dim, class Shape>
 void Simulation<Dim, Shape>::setup_particles() {
   const bool gimp = std::is_same_v<Shape, shape::Gimp>;
   interrupt_.stage("generating particles and evaluating their initial fields");
-  particles_.resize(static_cast<std::size_t>(count_particles(problem_)), fluid_, gimp,
-                    state_variables_);
+  const std::vector<BodyLayout> layouts = body_layouts(problem_);
+  std::int64_t count = 0;
+  for (const BodyLayout& l : layouts) count += l.count;
+  particles_.resize(static_cast<std::size_t>(count), fluid_, gimp, state_variables_);
   grid_.resize(fluid_);
   std::size_t p = 0;
   double cell_volume = 1.0;
   for (int a = 0; a < Dim; ++a) cell_volume *= grid_.h[a];
-  for (const Body& body : problem_.bodies) {
-    const BodyLayout layout = body_layout(problem_, body);
+  for (std::size_t b = 0; b < problem_.bodies.size(); ++b) {
+    const Body& body = problem_.bodies[b];
+    const BodyLayout& layout = layouts[b];
     const MaterialConstants& mc = constants_[static_cast<std::size_t>(body.material)];
     const int ppc = body.particles_per_cell;
-    const double v0 = cell_volume / std::pow(ppc, Dim);
-    for (double z : layout.coords[2])
-      for (double y : layout.coords[1])
-        for (double x : layout.coords[0]) {
-          interrupt_.poll(p);
-          const Vec3 x3{x, y, z};
-          for (int a = 0; a < Dim; ++a) particles_.x[p][a] = x3[a];
-          particles_.x0[p] = particles_.x[p];
-          particles_.volume[p] = v0;
-          particles_.mass[p] = mc.mixture_density * v0;
-          particles_.material[p] = static_cast<std::uint16_t>(body.material);
-          if (gimp) particles_.half_length[p] = 0.5 / ppc;
-          const InitialFields& init = body.initial;
-          for (int a = 0; a < Dim; ++a)
-            if (init.velocity[a]) particles_.v[p][a] = init.velocity[a](x3);
-          for (int c = 0; c < 6; ++c)
-            if (init.effective_stress[c]) particles_.stress[p][c] = init.effective_stress[c](x3);
-          if (fluid_ && mc.saturated) {
-            const double p0 = init.pore_pressure ? init.pore_pressure(x3) : 0.0;
-            particles_.pressure[p] = p0;
-            particles_.pressure_out[p] = p0;
-            particles_.porosity[p] = mc.porosity;
-          }
-          ++p;
-        }
+    for (std::size_t k = 0; k < layout.positions.size(); ++k) {
+      interrupt_.poll(p);
+      const Vec3& x3 = layout.positions[k];
+      const double v0 = layout.volumes[k];
+      for (int a = 0; a < Dim; ++a) particles_.x[p][a] = x3[a];
+      particles_.x0[p] = particles_.x[p];
+      particles_.volume[p] = v0;
+      particles_.mass[p] = mc.mixture_density * v0;
+      particles_.material[p] = static_cast<std::uint16_t>(body.material);
+      // GIMP half-length in cell units: of the sub-cell, or of the cube
+      // of a points body's particle volume.
+      if (gimp)
+        particles_.half_length[p] =
+            body.points ? 0.5 * std::pow(v0 / cell_volume, 1.0 / Dim) : 0.5 / ppc;
+      const InitialFields& init = body.initial;
+      for (int a = 0; a < Dim; ++a)
+        if (init.velocity[a]) particles_.v[p][a] = init.velocity[a](x3);
+      for (int c = 0; c < 6; ++c)
+        if (init.effective_stress[c]) particles_.stress[p][c] = init.effective_stress[c](x3);
+      if (fluid_ && mc.saturated) {
+        const double p0 = init.pore_pressure ? init.pore_pressure(x3) : 0.0;
+        particles_.pressure[p] = p0;
+        particles_.pressure_out[p] = p0;
+        particles_.porosity[p] = mc.porosity;
+      }
+      ++p;
+    }
   }
 }
 

@@ -29,6 +29,37 @@ double evaluation_cost(std::size_t length) {
   return static_cast<double>(length) + formula_overhead_characters;
 }
 
+// Work bound for filling polygons and prisms: candidate positions x the
+// polygon's vertices (each laying out tests every candidate against every
+// edge; validation lays the bodies out a few times).
+constexpr double max_polygon_work = 2e8;
+
+/// The box a body's particles lie in: its box, or the bounding box of its
+/// polygon or prism (points bodies: unused).
+Box shape_bounds(const Body& body) {
+  Box out = body.box;
+  const std::vector<std::array<double, 2>>* vertices = nullptr;
+  std::array<int, 2> plane{0, 1};
+  if (body.polygon) vertices = &body.polygon->vertices;
+  if (body.prism) {
+    vertices = &body.prism->polygon.vertices;
+    const int axis = body.prism->axis;
+    plane = axis == 0 ? std::array<int, 2>{1, 2}
+                      : (axis == 1 ? std::array<int, 2>{0, 2} : std::array<int, 2>{0, 1});
+    out.min[axis] = body.prism->from;
+    out.max[axis] = body.prism->to;
+  }
+  if (!vertices || vertices->empty()) return out;
+  for (int k = 0; k < 2; ++k) {
+    out.min[plane[k]] = out.max[plane[k]] = vertices->front()[k];
+    for (const auto& v : *vertices) {
+      out.min[plane[k]] = std::min(out.min[plane[k]], v[k]);
+      out.max[plane[k]] = std::max(out.max[plane[k]], v[k]);
+    }
+  }
+  return out;
+}
+
 bool check_particle_budget(ParseContext& c) {
   // Count particles from the layout rule without generating them, so a huge
   // body is refused before anything allocates per particle.
@@ -49,11 +80,20 @@ bool check_particle_budget(ParseContext& c) {
   double total = 0;
   for (std::size_t b = 0; b < p.bodies.size(); ++b) {
     const Body& body = p.bodies[b];
+    if (body.points) {
+      total += static_cast<double>(body.points->positions.size());
+      continue;
+    }
+    const Box range = shape_bounds(body);
+    const bool shaped = body.polygon || body.prism;
     double n = 1;
     for (int a = 0; a < c.dim; ++a) {
-      const double along =
-          static_cast<double>(cells_inside(p.grid, a, body.box.min[a], body.box.max[a])) *
-          body.particles_per_cell;
+      // A polygon or prism fills at most the sub-cells of the cells meeting
+      // its bounding box.
+      const double cells =
+          shaped ? static_cast<double>(nodes_inside(p.grid, a, range.min[a], range.max[a]) + 1)
+                 : static_cast<double>(cells_inside(p.grid, a, range.min[a], range.max[a]));
+      const double along = cells * body.particles_per_cell;
       if (along > static_cast<double>(c.limits.max_particles)) {
         c.r.error(child_pointer("/bodies", b) + "/particles_per_cell",
                   "body would have " + format_count(along) + " particles along " +
@@ -62,6 +102,19 @@ bool check_particle_budget(ParseContext& c) {
         return false;
       }
       n *= along;
+    }
+    if (shaped) {
+      const std::size_t vertices =
+          body.polygon ? body.polygon->vertices.size() : body.prism->polygon.vertices.size();
+      if (n * static_cast<double>(vertices) > max_polygon_work) {
+        c.r.error(child_pointer("/bodies", b) + (body.polygon ? "/polygon" : "/prism/polygon"),
+                  "filling it tests " + format_count(n) + " sub-cell centres against " +
+                      std::to_string(vertices) + " edges, too much work (" +
+                      format_count(n * static_cast<double>(vertices)) + " > " +
+                      format_count(max_polygon_work) +
+                      "); use fewer vertices, fewer particles per cell or a coarser grid");
+        return false;
+      }
     }
     total += n;
   }
@@ -91,6 +144,51 @@ void resolve_near(ParseContext& c) {
   }
 }
 
+/// Replaces each {"polygon": ...} entry of output.series.particles by the
+/// particles inside or on the polygon (as a traction selects them).
+void resolve_series_polygons(ParseContext& c) {
+  if (c.series_polygons.empty()) return;
+  for (const PendingPolygon& pp : c.series_polygons) {
+    std::vector<ProblemIssue> issues;
+    check_polygon(pp.polygon, Location{}, issues);
+    for (const ProblemIssue& issue : issues)
+      c.r.error(pp.path + "/polygon" + pointer_of_solver_location(issue.where), issue.message);
+  }
+  if (c.r.error_count() > 0) return;
+  std::vector<std::int64_t>& parts = c.p.output.series_particles;
+  const std::vector<Vec3> positions = initial_positions(c.p);
+  if (static_cast<double>(c.series_polygons.size()) * static_cast<double>(positions.size()) >
+      max_near_work) {
+    c.r.error("/output/series/particles", "too many 'polygon' selections over " +
+                                              std::to_string(positions.size()) +
+                                              " particles to resolve; name particles by index");
+    return;
+  }
+  std::vector<std::int64_t> out;
+  std::size_t next = 0;
+  for (std::size_t slot = 0; slot < parts.size(); ++slot) {
+    if (next < c.series_polygons.size() && c.series_polygons[next].slot == slot) {
+      const PendingPolygon& pp = c.series_polygons[next++];
+      Traction as_selection;
+      as_selection.polygon = pp.polygon;
+      const std::size_t before = out.size();
+      for (std::size_t i = 0; i < positions.size(); ++i)
+        if (particle_selected(c.p, as_selection, positions[i]))
+          out.push_back(static_cast<std::int64_t>(i));
+      if (out.size() == before) c.r.error(pp.path + "/polygon", "selects no particle");
+      continue;
+    }
+    out.push_back(parts[slot]);
+  }
+  if (out.size() > static_cast<std::size_t>(c.limits.max_series_particles)) {
+    c.r.error("/output/series/particles", "selects " + std::to_string(out.size()) +
+                                              " particles; the limit is " +
+                                              std::to_string(c.limits.max_series_particles));
+    return;
+  }
+  parts = std::move(out);
+}
+
 void check_traction_selections(ParseContext& c) {
   // A convenience check, skipped when it would cost more than a moment.
   const Problem& p = c.p;
@@ -100,12 +198,8 @@ void check_traction_selections(ParseContext& c) {
     return;
   const std::vector<Vec3> positions = initial_positions(p);
   for (std::size_t k = 0; k < p.tractions.size(); ++k) {
-    const Box& box = p.tractions[k].particles;
     const bool any = std::any_of(positions.begin(), positions.end(), [&](const Vec3& x) {
-      for (int a = 0; a < c.dim; ++a)
-        if (x[a] < box.min[a] - 1e-12 || x[a] > box.max[a] + 1e-12)
-          return false;  // as the solver selects
-      return true;
+      return particle_selected(p, p.tractions[k], x);  // as the solver selects
     });
     if (!any)
       c.r.error(c.traction_paths[k],
@@ -151,10 +245,9 @@ void check_position_formulas(ParseContext& c) {
       Problem one;
       one.dimension = p.dimension;
       one.grid = p.grid;
-      Body b;
-      b.box = p.bodies[pf.body].box;
-      b.particles_per_cell = p.bodies[pf.body].particles_per_cell;
-      one.bodies.push_back(b);
+      Body b = p.bodies[pf.body];
+      b.initial = InitialFields{};
+      one.bodies.push_back(std::move(b));
       positions[pf.body] = initial_positions(one);
     }
     work += static_cast<double>(positions[pf.body].size()) * evaluation_cost(pf.length);
@@ -216,6 +309,7 @@ void check_limits(ParseContext& c) {
 void check_whole_problem(ParseContext& c) {
   if (!check_particle_budget(c)) return;
   resolve_near(c);
+  resolve_series_polygons(c);
   for (const ProblemIssue& issue : check_problem(c.p))
     c.r.error(pointer_of_solver_location(issue.where), issue.message);
   if (c.r.error_count() > 0) return;

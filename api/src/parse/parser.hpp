@@ -51,6 +51,15 @@ struct PendingNear {
   std::string path;
 };
 
+/// An output.series particle entry {"polygon": [...]} (2D): every particle
+/// whose initial position lies inside or on it, in numbering order, replaces
+/// the entry once the particles are known.
+struct PendingPolygon {
+  std::size_t slot;  ///< index into series_particles
+  Polygon polygon;
+  std::string path;
+};
+
 /// The state of one parse: the reader with its errors, the Problem being
 /// built and what the whole-problem checks need later.
 struct ParseContext {
@@ -64,6 +73,7 @@ struct ParseContext {
   bool grid_ok = false;  ///< grid valid: boxes can be checked against it
   std::map<std::string, int> material_index;
   std::vector<PendingNear> near;
+  std::vector<PendingPolygon> series_polygons;
   std::vector<PositionFormula> position_formulas;
   std::vector<TimeFormula> time_formulas;
   bool damping_formula = false;         ///< local_damping given as a formula of t
@@ -93,9 +103,16 @@ void read_output(ParseContext& c, const json& j, const std::string& path);
 // ------------------------------------------------------ shared value readers
 /// {"min": [...], "max": [...]} inside the grid (when the grid is valid).
 std::optional<Box> read_box(ParseContext& c, const json& j, const std::string& path);
-/// {"box": {...}} or "all"; "all" is the whole grid.
+/// [[u, v], ...]: a plane polygon of 3 or more vertices, whose coordinates
+/// are along the axes `plane` (inside the grid when it is valid). Whether it
+/// is simple is checked with the whole Problem (check_problem).
+std::optional<Polygon> read_polygon(ParseContext& c, const json& j, const std::string& path,
+                                    std::array<int, 2> plane);
+/// {"box": {...}}, {"polygon": [[x, y], ...]} (2D) or "all"; "all" is the
+/// whole grid. A polygon is stored in `*polygon` and its bounding box
+/// returned.
 std::optional<Box> read_selection(ParseContext& c, const json& j, const std::string& path,
-                                  bool& all);
+                                  bool& all, std::optional<Polygon>* polygon);
 /// The keys of a box and of a selection object (for the key tables).
 Keys box_key_names();
 Keys selection_key_names();

@@ -84,15 +84,34 @@ std::vector<ProblemIssue> check_problem(const Problem& problem);
 /// `where` in the job-spec vocabulary and a message saying what to change.
 /// Today: materials whose fluid is so compressible that the u-p equations
 /// with Darcy's rho_f a term are near or past their stability limit
-/// (docs/verification.md). The run's RunResult::warnings repeat them.
+/// (docs/verification.md); bodies that lose particle positions to an
+/// earlier body where they overlap. The run's RunResult::warnings repeat them.
 std::vector<ProblemIssue> problem_warnings(const Problem& problem);
 
-/// Number of particles the bodies generate (cheap; no allocation per particle).
+/// Number of particles the bodies generate (lays the bodies out).
 std::int64_t count_particles(const Problem& problem);
 
 /// Initial positions of every particle, in the global numbering of the
-/// contract (bodies in order; in a body x fastest, then y, then z).
+/// contract (bodies in order; in a box, polygon or prism body x fastest,
+/// then y, then z; in a points body the given order), without the
+/// positions a body loses to an earlier one.
 std::vector<Vec3> initial_positions(const Problem& problem);
+
+/// Appends to `issues` what makes `polygon` unusable, at `where` (or an
+/// index under it): fewer than 3 vertices, a repeated vertex, zero area,
+/// edges that cross or touch. check_problem runs it on every polygon of the
+/// Problem.
+void check_polygon(const Polygon& polygon, const Location& where,
+                   std::vector<ProblemIssue>& issues);
+
+/// Whether a grid node at `x` belongs to the selection (its box, with a
+/// tolerance of 1e-9 cell sizes, or its polygon, inside or on the boundary
+/// within 1e-6 of the smallest cell size).
+bool node_selected(const Problem& problem, const NodeSelection& nodes, const Vec3& x);
+
+/// Whether a particle with initial position `x` is loaded by the traction
+/// (inside its box, or inside or on its polygon as node_selected).
+bool particle_selected(const Problem& problem, const Traction& traction, const Vec3& x);
 
 /// Index of the particle whose initial position is nearest to `x`; -1 if none.
 std::int64_t nearest_particle(const Problem& problem, const Vec3& x);
