@@ -5,6 +5,8 @@
 // the same `--db` or `--data-dir` fails here with the other one's pid. Each
 // process is one store instance (`instance_id`): its claims carry that id,
 // its heartbeat renews their leases. Requests are served by http/.
+#include <sys/socket.h>
+
 #include <chrono>
 #include <condition_variable>
 #include <mutex>
@@ -14,6 +16,7 @@
 #include "digest.hpp"
 #include "hmpm/server/service.hpp"
 #include "hmpm/server/store.hpp"
+#include "http/connection.hpp"
 #include "http/server_setup.hpp"
 #include "job_log.hpp"
 #include "metrics.hpp"
@@ -57,6 +60,15 @@ WorkerSettings worker_settings(const ServiceConfig& c, const hmpm::api::Limits& 
                         .lease_renewal_s = c.lease_s / 3.0};
 }
 
+http::ConnectionLimits connection_limits(const ServiceConfig& c) {
+  http::ConnectionLimits limits;
+  limits.head_timeout_s = c.head_timeout_s;
+  limits.body_timeout_s = c.body_timeout_s;
+  limits.core_threads = static_cast<std::size_t>(c.http_threads);
+  limits.max_connections = static_cast<std::size_t>(std::max(c.max_connections, c.http_threads));
+  return limits;
+}
+
 void log_recovery(const RecoveryReport& recovery) {
   for (const auto& id : recovery.requeued) {
     log_line({{"event", "job"},
@@ -85,7 +97,8 @@ struct Service::Impl {
         workers(*store, metrics, worker_settings(config, limits, instance_id)),
         context{config, limits, *store, metrics, workers, stopping},
         auth(config.token),
-        router(http::route_table(), context, auth) {
+        router(http::route_table(), context, auth),
+        server(connection_limits(config)) {
     log_recovery(store->recover(config.max_attempts));
     http::configure_server(server, context, router, auth);
   }
@@ -101,7 +114,7 @@ struct Service::Impl {
   http::Context context;
   http::Authenticator auth;
   http::Router router;
-  httplib::Server server;
+  http::HardenedServer server;
   int port = -1;
   std::atomic<bool> run_started{false};
   std::atomic<bool> run_finished{false};
@@ -145,6 +158,7 @@ int Service::bind() {
     s.port = s.server.bind_to_port(s.config.host, s.config.port) ? s.config.port : -1;
   }
   if (s.port <= 0) s.port = -1;
+  if (s.port > 0) s.server.widen_backlog(SOMAXCONN);
   return s.port;
 }
 
@@ -163,6 +177,7 @@ bool Service::run() {
             {"data_dir", s.config.data_dir.string()},
             {"instance", s.instance_id},
             {"auth", !s.config.token.empty()},
+            {"max_connections", s.config.max_connections},
             {"retain_days", s.config.retain_days}});
   std::thread retention;
   if (s.config.retain_days > 0) retention = std::thread([&s] { s.retention_loop(); });
