@@ -219,7 +219,10 @@ ParsedOptions parse_options(const std::vector<std::string>& args, const char* en
     if (const std::string problem = it->second(value); !problem.empty()) {
       result.error = flag;
       // Never echo a secret.
-      result.error.append(" ").append(flag == "--token" ? "''" : value).append(": ").append(problem);
+      result.error.append(" ")
+          .append(flag == "--token" ? "''" : value)
+          .append(": ")
+          .append(problem);
       return result;
     }
     given.insert(flag);

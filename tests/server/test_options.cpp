@@ -88,7 +88,6 @@ TEST(Options, MistakesAreReportedNotFatal) {
   EXPECT_TRUE(parse_options({"--help"}, nullptr).help);
 }
 
-
 // A server reachable from other machines needs a token, or an explicit
 // --allow-no-token; an empty token is always a mistake.
 TEST(Options, InsecureStartsAreRefused) {
@@ -101,7 +100,8 @@ TEST(Options, InsecureStartsAreRefused) {
   for (const char* loopback : {"127.0.0.1", "127.1.2.3", "::1", "[::1]", "localhost"}) {
     EXPECT_TRUE(parse_options({"--db", "d", "--host", loopback}, nullptr).config) << loopback;
   }
-  const auto allowed = parse_options({"--db", "d", "--host", "0.0.0.0", "--allow-no-token"}, nullptr);
+  const auto allowed =
+      parse_options({"--db", "d", "--host", "0.0.0.0", "--allow-no-token"}, nullptr);
   ASSERT_TRUE(allowed.config) << allowed.error;
   EXPECT_TRUE(allowed.config->allow_no_token);
   EXPECT_TRUE(parse_options({"--db", "d", "--host", "0.0.0.0"}, "env").config);
@@ -121,13 +121,14 @@ TEST(Options, TokenFileKeepsTheSecretOffTheCommandLine) {
   const auto parsed = parse_options({"--db", "d", "--token-file", file.string()}, "env");
   ASSERT_TRUE(parsed.config) << parsed.error;
   EXPECT_EQ(parsed.config->token, "from-file");  // wins over HMPM_TOKEN, newline dropped
-  EXPECT_FALSE(parse_options({"--db", "d", "--token-file", file.string(), "--token", "t"}, nullptr)
-                   .config);
+  EXPECT_FALSE(
+      parse_options({"--db", "d", "--token-file", file.string(), "--token", "t"}, nullptr).config);
   std::ofstream(file) << "\n";
-  EXPECT_NE(parse_options({"--db", "d", "--token-file", file.string()}, nullptr).error.find("empty"),
-            std::string::npos);
-  EXPECT_FALSE(parse_options({"--db", "d", "--token-file", (dir / "missing").string()}, nullptr)
-                   .config);
+  EXPECT_NE(
+      parse_options({"--db", "d", "--token-file", file.string()}, nullptr).error.find("empty"),
+      std::string::npos);
+  EXPECT_FALSE(
+      parse_options({"--db", "d", "--token-file", (dir / "missing").string()}, nullptr).config);
   std::filesystem::remove_all(dir);
 }
 

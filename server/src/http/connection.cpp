@@ -87,8 +87,7 @@ class DeadlineStream final : public httplib::Stream {
   bool has_buffered() const { return begin_ < end_; }
 
   bool is_readable() const override {
-    return has_buffered() ||
-           wait_for(sock_, POLLIN, ms_until(deadline_, read_timeout_ms_));
+    return has_buffered() || wait_for(sock_, POLLIN, ms_until(deadline_, read_timeout_ms_));
   }
 
   bool is_writable() const override {
@@ -162,7 +161,8 @@ class DeadlineStream final : public httplib::Stream {
       bool ready = false;
       while (!ready) {
         if (in_head_ && listener_ == INVALID_SOCKET) return false;
-        const int wait_ms = std::min(ms_until(deadline_, slice_ms), ms_until(quiet_until, slice_ms));
+        const int wait_ms =
+            std::min(ms_until(deadline_, slice_ms), ms_until(quiet_until, slice_ms));
         if (wait_ms == 0) break;
         ready = wait_for(sock_, POLLIN, wait_ms);
       }

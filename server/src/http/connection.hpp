@@ -28,13 +28,13 @@
 namespace hmpm::server::http {
 
 struct ConnectionLimits {
-  double head_timeout_s = 10.0;   ///< request line + headers, in total
-  double body_timeout_s = 60.0;   ///< the whole body, in total
+  double head_timeout_s = 10.0;  ///< request line + headers, in total
+  double body_timeout_s = 60.0;  ///< the whole body, in total
   std::size_t max_head_bytes = 65536;
   std::size_t max_header_count = 100;
-  std::size_t core_threads = 24;    ///< threads kept ready
+  std::size_t core_threads = 24;      ///< threads kept ready
   std::size_t max_connections = 256;  ///< served at once; 503 and close beyond
-  double linger_s = 1.0;            ///< draining an unread body after a refusal
+  double linger_s = 1.0;              ///< draining an unread body after a refusal
 };
 
 /// Why the current request's head or body was cut off (for the status the

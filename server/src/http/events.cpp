@@ -52,8 +52,9 @@ void stream_events(Context& c, const httplib::Request& req, httplib::Response& r
   }
   auto state = std::make_shared<StreamState>();
   state->id = id;
-  state->ends = SteadyClock::now() + std::chrono::duration_cast<SteadyClock::duration>(
-                                         std::chrono::duration<double>(c.config.event_stream_max_s));
+  state->ends =
+      SteadyClock::now() + std::chrono::duration_cast<SteadyClock::duration>(
+                               std::chrono::duration<double>(c.config.event_stream_max_s));
   res.set_header("Cache-Control", "no-cache");
   res.set_header("X-Accel-Buffering", "no");
   // httplib calls the provider until it signals done (or a write fails); each

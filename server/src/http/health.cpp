@@ -10,8 +10,9 @@ void get_health(Context& c, const httplib::Request&, httplib::Response& res) {
     c.store.probe();
     Json doc{{"status", "ok"}};
     if (c.config.token.empty() && !is_loopback_host(c.config.host)) {
-      doc["warning"] = "no token on a non-loopback address (--allow-no-token): the API is open "
-                       "to anyone who can reach it";
+      doc["warning"] =
+          "no token on a non-loopback address (--allow-no-token): the API is open "
+          "to anyone who can reach it";
     }
     send_json(res, 200, doc);
   } catch (const std::exception&) {

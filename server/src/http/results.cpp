@@ -48,8 +48,7 @@ std::optional<JobRecord> finished_job(Context& c, const std::string& ref, httpli
 std::string etag_of(const ResultFile& file, const struct stat& st) {
   std::ostringstream tag;
   tag << '"' << file.sha256 << '-' << std::hex << st.st_ino << '-'
-      << (static_cast<long long>(st.st_mtim.tv_sec) * 1'000'000'000LL + st.st_mtim.tv_nsec)
-      << '"';
+      << (static_cast<long long>(st.st_mtim.tv_sec) * 1'000'000'000LL + st.st_mtim.tv_nsec) << '"';
   return tag.str();
 }
 
@@ -128,7 +127,8 @@ void get_result_file(Context& c, const httplib::Request& req, httplib::Response&
   const auto path = c.workers.job_dir(job->id) / file->name;
   struct stat st {};
   auto in = std::make_shared<std::ifstream>(path, std::ios::binary);
-  if (::stat(path.c_str(), &st) != 0 || !*in || static_cast<std::int64_t>(st.st_size) != file->size) {
+  if (::stat(path.c_str(), &st) != 0 || !*in ||
+      static_cast<std::int64_t>(st.st_size) != file->size) {
     log_line({{"event", "error"},
               {"job", job->id},
               {"detail", "result file missing or changed: " + file->name}});

@@ -46,8 +46,8 @@ bool httplib_method(const std::string& m) {
 }
 
 bool served_method(const std::string& m) {
-  return m == "GET" || m == "HEAD" || m == "POST" || m == "PUT" || m == "PATCH" ||
-         m == "DELETE" || m == "OPTIONS";
+  return m == "GET" || m == "HEAD" || m == "POST" || m == "PUT" || m == "PATCH" || m == "DELETE" ||
+         m == "OPTIONS";
 }
 
 void not_implemented(httplib::Response& res, const std::string& method) {
