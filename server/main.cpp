@@ -36,6 +36,13 @@ int main(int argc, char** argv) {
     return exit_status(ExitCode::server_usage);
   }
 
+  const hmpm::server::ServiceConfig& given = *parsed.config;
+  if (given.token.empty() && !hmpm::server::is_loopback_host(given.host)) {
+    std::cerr << "hmpm-server: WARNING: listening on " << given.host
+              << " without a token (--allow-no-token): anyone who can reach this address can "
+                 "submit, read and delete jobs\n";
+  }
+
   // Block the stop signals before any thread exists, so all threads inherit
   // the mask and only the signal thread below receives them.
   sigset_t stop_signals;

@@ -8,6 +8,8 @@
 // apart. Each process is one store instance (`instance_id`): its claims carry
 // that id, its heartbeat renews their leases and takes over lapsed ones
 // (worker_pool.hpp). Requests are served by http/.
+#include <sys/socket.h>
+
 #include <chrono>
 #include <condition_variable>
 #include <mutex>
@@ -19,6 +21,7 @@
 #include "hmpm/server/service.hpp"
 #include "hmpm/server/store.hpp"
 #include "http/drain.hpp"
+#include "http/connection.hpp"
 #include "http/server_setup.hpp"
 #include "http/validation_gate.hpp"
 #include "job_limits.hpp"
@@ -87,6 +90,15 @@ int validation_turns() {
 }
 constexpr double validation_wait_s = 10.0;
 
+http::ConnectionLimits connection_limits(const ServiceConfig& c) {
+  http::ConnectionLimits limits;
+  limits.head_timeout_s = c.head_timeout_s;
+  limits.body_timeout_s = c.body_timeout_s;
+  limits.core_threads = static_cast<std::size_t>(c.http_threads);
+  limits.max_connections = static_cast<std::size_t>(std::max(c.max_connections, c.http_threads));
+  return limits;
+}
+
 void log_recovery(const RecoveryReport& recovery) {
   for (const auto& id : recovery.requeued) {
     log_line({{"event", "job"},
@@ -115,7 +127,8 @@ struct Service::Impl {
         validation(validation_turns(), std::max(2, config.http_threads / 4), validation_wait_s),
         context{config, limits, *store, metrics, workers, stopping, validation},
         auth(config.token),
-        router(http::route_table(), context, auth) {
+        router(http::route_table(), context, auth),
+        server(connection_limits(config)) {
     metrics.instance = instance_id;
     log_recovery(store->recover(config.max_attempts, config.charge_after_s));
     http::configure_server(server, context, router, auth);
@@ -145,7 +158,7 @@ struct Service::Impl {
   http::Context context;
   http::Authenticator auth;
   http::Router router;
-  httplib::Server server;
+  http::HardenedServer server;
   int port = -1;
   std::atomic<bool> run_started{false};
   std::atomic<bool> run_finished{false};
@@ -200,6 +213,7 @@ int Service::bind() {
     s.port = s.server.bind_to_port(s.config.host, s.config.port) ? s.config.port : -1;
   }
   if (s.port <= 0) s.port = -1;
+  if (s.port > 0) s.server.widen_backlog(SOMAXCONN);
   return s.port;
 }
 
@@ -222,7 +236,8 @@ bool Service::run() {
             {"job_wall_time_s", s.config.job_wall_time_s},
             {"max_particles", s.config.max_particles},
             {"max_particle_steps", s.config.max_particle_steps},
-            {"max_job_memory", s.config.max_job_memory}});
+            {"max_job_memory", s.config.max_job_memory},
+            {"max_connections", s.config.max_connections}});
   std::thread retention;
   if (s.config.retain_days > 0) retention = std::thread([&s] { s.retention_loop(); });
   const bool ok = s.stopping || s.server.listen_after_bind();

@@ -2,6 +2,9 @@
 // HMPM_TOKEN, and the ways to get it wrong.
 #include <gtest/gtest.h>
 
+#include <filesystem>
+#include <fstream>
+
 #include "hmpm/server/options.hpp"
 
 namespace hmpm::server {
@@ -121,6 +124,71 @@ TEST(Options, MistakesAreReportedNotFatal) {
             std::string::npos);
   EXPECT_NE(parse_options({"--db"}, nullptr).error.find("needs a value"), std::string::npos);
   EXPECT_TRUE(parse_options({"--help"}, nullptr).help);
+}
+
+// A server reachable from other machines needs a token, or an explicit
+// --allow-no-token; an empty token is always a mistake.
+TEST(Options, InsecureStartsAreRefused) {
+  EXPECT_NE(parse_options({"--db", "d", "--host", "0.0.0.0"}, nullptr).error.find("token"),
+            std::string::npos);
+  EXPECT_NE(parse_options({"--db", "d", "--host", "::"}, nullptr).error.find("token"),
+            std::string::npos);
+  EXPECT_NE(parse_options({"--db", "d", "--host", "example.org"}, nullptr).error.find("token"),
+            std::string::npos);
+  for (const char* loopback : {"127.0.0.1", "127.1.2.3", "::1", "[::1]", "localhost"}) {
+    EXPECT_TRUE(parse_options({"--db", "d", "--host", loopback}, nullptr).config) << loopback;
+  }
+  const auto allowed =
+      parse_options({"--db", "d", "--host", "0.0.0.0", "--allow-no-token"}, nullptr);
+  ASSERT_TRUE(allowed.config) << allowed.error;
+  EXPECT_TRUE(allowed.config->allow_no_token);
+  EXPECT_TRUE(parse_options({"--db", "d", "--host", "0.0.0.0"}, "env").config);
+  // --token '' does not quietly switch HMPM_TOKEN off, and the error shows no value.
+  const auto empty = parse_options({"--db", "d", "--token", ""}, "env");
+  EXPECT_FALSE(empty.config);
+  EXPECT_NE(empty.error.find("--token"), std::string::npos);
+  EXPECT_FALSE(parse_options({"--db", "d", "--token="}, nullptr).config);
+  EXPECT_FALSE(parse_options({"--db", "d"}, "").config);
+}
+
+TEST(Options, TokenFileKeepsTheSecretOffTheCommandLine) {
+  const auto dir = std::filesystem::temp_directory_path() / "hmpm-options-token";
+  std::filesystem::create_directories(dir);
+  const auto file = dir / "token";
+  std::ofstream(file) << "from-file\n";
+  const auto parsed = parse_options({"--db", "d", "--token-file", file.string()}, "env");
+  ASSERT_TRUE(parsed.config) << parsed.error;
+  EXPECT_EQ(parsed.config->token, "from-file");  // wins over HMPM_TOKEN, newline dropped
+  EXPECT_FALSE(
+      parse_options({"--db", "d", "--token-file", file.string(), "--token", "t"}, nullptr).config);
+  std::ofstream(file) << "\n";
+  EXPECT_NE(
+      parse_options({"--db", "d", "--token-file", file.string()}, nullptr).error.find("empty"),
+      std::string::npos);
+  EXPECT_FALSE(
+      parse_options({"--db", "d", "--token-file", (dir / "missing").string()}, nullptr).config);
+  std::filesystem::remove_all(dir);
+}
+
+// Each event stream holds an HTTP thread: a cap at or above the thread
+// count would let streams starve /health.
+TEST(Options, StreamCapMustStayBelowTheHttpThreads) {
+  EXPECT_NE(parse_options({"--db", "d", "--max-event-streams", "24"}, nullptr)
+                .error.find("--http-threads"),
+            std::string::npos);
+  EXPECT_TRUE(
+      parse_options({"--db", "d", "--max-event-streams", "23", "--http-threads", "24"}, nullptr)
+          .config);
+  const auto parsed =
+      parse_options({"--db", "d", "--max-connections", "64", "--request-head-timeout", "2.5",
+                     "--request-body-timeout", "30", "--event-stream-max-seconds", "5"},
+                    nullptr);
+  ASSERT_TRUE(parsed.config) << parsed.error;
+  EXPECT_EQ(parsed.config->max_connections, 64);
+  EXPECT_DOUBLE_EQ(parsed.config->head_timeout_s, 2.5);
+  EXPECT_DOUBLE_EQ(parsed.config->body_timeout_s, 30.0);
+  EXPECT_DOUBLE_EQ(parsed.config->event_stream_max_s, 5.0);
+  EXPECT_FALSE(parse_options({"--db", "d", "--request-head-timeout", "0"}, nullptr).config);
 }
 
 }  // namespace

@@ -272,14 +272,14 @@ TEST_F(RoutesTest, AllowListsExactlyTheMethodsServed) {
   start();
   const std::string job = "/jobs/00000000-0000-4000-8000-000000000000";
   const std::vector<std::pair<std::string, std::string>> expected{
-      {"/health", "GET, HEAD"},
-      {"/metrics", "GET, HEAD"},
-      {"/jobs", "GET, HEAD, POST"},
-      {job, "GET, HEAD, DELETE"},
-      {job + "/spec", "GET, HEAD"},
-      {job + "/results", "GET, HEAD"},
-      {job + "/results/summary.json", "GET, HEAD"},
-      {job + "/events", "GET, HEAD"},
+      {"/health", "GET, HEAD, OPTIONS"},
+      {"/metrics", "GET, HEAD, OPTIONS"},
+      {"/jobs", "GET, HEAD, POST, OPTIONS"},
+      {job, "GET, HEAD, DELETE, OPTIONS"},
+      {job + "/spec", "GET, HEAD, OPTIONS"},
+      {job + "/results", "GET, HEAD, OPTIONS"},
+      {job + "/results/summary.json", "GET, HEAD, OPTIONS"},
+      {job + "/events", "GET, HEAD, OPTIONS"},
   };
   for (const auto& [path, allow] : expected) {
     auto res = client_->Patch(path.c_str(), "{}", "application/json");

@@ -1,5 +1,6 @@
 // health.cpp — GET /health (no token: for load balancers) and GET /metrics.
 #include "handlers.hpp"
+#include "hmpm/server/options.hpp"
 #include "problem.hpp"
 
 namespace hmpm::server::http {
@@ -9,7 +10,13 @@ namespace hmpm::server::http {
 void get_health(Context& c, const httplib::Request&, httplib::Response& res) {
   try {
     c.store.probe();
-    send_json(res, 200, Json{{"status", "ok"}});
+    Json doc{{"status", "ok"}};
+    if (c.config.token.empty() && !is_loopback_host(c.config.host)) {
+      doc["warning"] =
+          "no token on a non-loopback address (--allow-no-token): the API is open "
+          "to anyone who can reach it";
+    }
+    send_json(res, 200, doc);
   } catch (const StoreFailure& e) {
     const std::string what = e.what();
     const bool unwritable = what.find("cannot be written") != std::string::npos;

@@ -47,8 +47,13 @@ struct ServiceConfig {
   /// least this long (JobStore::recover).
   double charge_after_s = 30.0;
   std::size_t max_body_bytes = std::size_t{16} << 20;  ///< request body limit (413)
-  int max_event_streams = 8;           ///< concurrent GET /jobs/{id}/events (503 beyond)
-  int http_threads = 24;               ///< connections served at once
+  int max_event_streams = 8;          ///< concurrent GET /jobs/{id}/events (503 beyond)
+  int http_threads = 24;              ///< HTTP threads kept ready (more are made on demand)
+  int max_connections = 256;          ///< connections served at once (a thread each); 503 beyond
+  double head_timeout_s = 10.0;       ///< a request's line and headers must arrive within this
+  double body_timeout_s = 60.0;       ///< a request's body must arrive within this
+  double event_stream_max_s = 300.0;  ///< an event stream ends after this; the client reconnects
+  bool allow_no_token = false;  ///< a non-loopback --host without a token starts (with a warning)
   double progress_interval_s = 1.0;    ///< how often a running job's progress is stored
   double heartbeat_interval_s = 10.0;  ///< SSE comment line when nothing else was sent
   double lease_s = 30.0;  ///< a running job's claim lapses this long after its last renewal
