@@ -1,8 +1,8 @@
 // options.cpp — see options.hpp.
 #include "hmpm/server/options.hpp"
 
-#include "hmpm/server/store.hpp"
 #include <arpa/inet.h>
+#include "hmpm/server/store.hpp"
 
 #include <charconv>
 #include <cmath>

@@ -20,8 +20,8 @@
 #include "digest.hpp"
 #include "hmpm/server/service.hpp"
 #include "hmpm/server/store.hpp"
-#include "http/drain.hpp"
 #include "http/connection.hpp"
+#include "http/drain.hpp"
 #include "http/server_setup.hpp"
 #include "http/validation_gate.hpp"
 #include "job_limits.hpp"
@@ -97,22 +97,6 @@ http::ConnectionLimits connection_limits(const ServiceConfig& c) {
   limits.core_threads = static_cast<std::size_t>(c.http_threads);
   limits.max_connections = static_cast<std::size_t>(std::max(c.max_connections, c.http_threads));
   return limits;
-}
-
-void log_recovery(const RecoveryReport& recovery) {
-  for (const auto& id : recovery.requeued) {
-    log_line({{"event", "job"},
-              {"job", id},
-              {"status", status_name(JobStatus::accepted)},
-              {"recovered", true}});
-  }
-  for (const auto& id : recovery.failed) {
-    log_line({{"event", "job"},
-              {"job", id},
-              {"status", status_name(JobStatus::failed)},
-              {"recovered", true},
-              {"reason", "interrupted too often (see its failure reason)"}});
-  }
 }
 
 }  // namespace

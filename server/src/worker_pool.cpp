@@ -261,7 +261,8 @@ void WorkerPool::heartbeat() {
     try {
       // Takes over the jobs of servers whose lease lapsed (on one SQLite
       // file there are none: the lock voided them at start-up).
-      const RecoveryReport report = store_.recover(settings_.max_attempts, settings_.charge_after_s);
+      const RecoveryReport report =
+          store_.recover(settings_.max_attempts, settings_.charge_after_s);
       log_recovery(report);
       metrics_.recovered_jobs += static_cast<int>(report.requeued.size() + report.failed.size());
       for (std::size_t i = 0; i < report.requeued.size(); ++i) notify();

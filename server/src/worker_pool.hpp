@@ -51,8 +51,8 @@ struct WorkerSettings {
   /// Wall time between checkpoints of a running job (its solver state, from
   /// which a later attempt resumes); <= 0: none.
   double checkpoint_interval_s = 60.0;
-  int max_attempts = 3;           ///< recover(): starts of a job before it fails
-  double charge_after_s = 30.0;   ///< recover(): see ServiceConfig::charge_after_s
+  int max_attempts = 3;          ///< recover(): starts of a job before it fails
+  double charge_after_s = 30.0;  ///< recover(): see ServiceConfig::charge_after_s
 };
 
 /// One log line per job that recovery requeued or failed.

@@ -29,10 +29,10 @@ struct ServiceConfig {
   /// Result files; empty: <db dir>/results (SQLite only). With PostgreSQL it
   /// is shared by every server on the database, and not locked.
   std::filesystem::path data_dir;
-  int workers = 1;               ///< jobs run at the same time
-  int threads_per_job = 0;       ///< solver threads per job; <= 0: cores / workers
-  std::string token;             ///< non-empty: Bearer token required (not on /health)
-  long max_queue = 1000;         ///< accepted jobs before POST /jobs answers 503
+  int workers = 1;          ///< jobs run at the same time
+  int threads_per_job = 0;  ///< solver threads per job; <= 0: cores / workers
+  std::string token;        ///< non-empty: Bearer token required (not on /health)
+  long max_queue = 1000;    ///< accepted jobs before POST /jobs answers 503
   /// Per-job wall-clock limit, set-up included; <= 0: none.
   double job_wall_time_s = 86'400.0;
   std::int64_t max_particles = 2'000'000;  ///< particles per job (the parser's budget)
@@ -42,7 +42,7 @@ struct ServiceConfig {
   /// Estimated memory per job (cost.memory_bytes), refused at submit
   /// beyond; 0: half the physical memory / workers (job_limits.hpp); < 0: none.
   std::int64_t max_job_memory = 0;
-  int max_attempts = 3;            ///< crashes charged to a job before recovery fails it
+  int max_attempts = 3;  ///< crashes charged to a job before recovery fails it
   /// A crash is charged to a running job only when its attempt had run at
   /// least this long (JobStore::recover).
   double charge_after_s = 30.0;

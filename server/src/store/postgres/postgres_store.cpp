@@ -257,10 +257,11 @@ std::optional<JobRecord> PostgresStore::claim_next(const Claimant& who) {
 
 std::int64_t PostgresStore::renew_leases(const Claimant& who) {
   auto db = pool_.lease();
-  return exec(db.get(),
-              "UPDATE jobs SET lease_expires_ms = $1, alive_ms = $3 WHERE owner = $2 AND status = " +
-                  sql_name(JobStatus::running),
-              Params().add(lease_until(who)).add(who.instance).add(now_ms()))
+  return exec(
+             db.get(),
+             "UPDATE jobs SET lease_expires_ms = $1, alive_ms = $3 WHERE owner = $2 AND status = " +
+                 sql_name(JobStatus::running),
+             Params().add(lease_until(who)).add(who.instance).add(now_ms()))
       .affected();
 }
 
