@@ -91,15 +91,26 @@ def estimate_bytes(hmpm: Path, spec_path: Path, threads: int) -> float:
 
 
 def peak_rss_bytes(hmpm: Path, spec_path: Path, threads: int, out_dir: Path) -> float:
-    """Runs the job; its peak resident set (ru_maxrss of this child only)."""
-    proc = subprocess.Popen([str(hmpm), "run", str(spec_path), "--out", str(out_dir),
-                             "--threads", str(threads)],
-                            stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
-    _, status, usage = os.wait4(proc.pid, 0)
-    proc.returncode = os.waitstatus_to_exitcode(status)
-    if proc.returncode != 0:
-        raise RuntimeError(f"hmpm run exited {proc.returncode}: {proc.stderr.read()!r}")
-    return usage.ru_maxrss * 1024.0
+    """Runs the job; its peak resident set (ru_maxrss of that child only).
+
+    The run is started by a fresh interpreter, not by this process: a child's
+    ru_maxrss keeps the resident set it had before exec, which for a child
+    forked by a large test process (a few hundred MiB after an attack test)
+    would be counted as the job's. The fresh interpreter adds ~10 MiB at most.
+    """
+    launcher = (
+        "import os, sys\n"
+        "pid = os.posix_spawn(sys.argv[1], sys.argv[1:], os.environ,"
+        " file_actions=[(os.POSIX_SPAWN_OPEN, 1, os.devnull, os.O_WRONLY, 0)])\n"
+        "_, status, usage = os.wait4(pid, 0)\n"
+        "print(os.waitstatus_to_exitcode(status), usage.ru_maxrss)\n")
+    r = subprocess.run([sys.executable, "-c", launcher, str(hmpm), "run", str(spec_path), "--out",
+                        str(out_dir), "--threads", str(threads)],
+                       capture_output=True, text=True)
+    fields = r.stdout.split()
+    if r.returncode != 0 or len(fields) != 2 or fields[0] != "0":
+        raise RuntimeError(f"hmpm run failed ({r.stdout.strip()!r}): {r.stderr!r}")
+    return int(fields[1]) * 1024.0
 
 
 def measure(hmpm: Path, spec: dict, threads: int) -> tuple[float, float]:
