@@ -10,6 +10,8 @@ packages=(
   nlohmann-json3-dev       # api: JSON parsing
   libmuparser-dev          # api: expressions in job specs
   libsqlite3-dev           # server: job store
+  libpq-dev                # server: the PostgreSQL job store (libpq)
+  postgresql               # tests: a throw-away PostgreSQL (scripts/postgres.sh)
   libcpp-httplib-dev       # server: HTTP (0.11.4, compiled library)
   libssl-dev zlib1g-dev libbrotli-dev  # what libcpp-httplib links against
   libgtest-dev libgmock-dev            # tests

@@ -32,10 +32,20 @@ if [ -n "$tidy_base" ] && git rev-parse --verify -q "$tidy_base^{commit}" >/dev/
 else
   stage tidy bash scripts/check_tidy.sh
 fi
+# A throw-away PostgreSQL for the store contract suite and the many-server
+# tests (scripts/postgres.sh: initdb in a temporary folder, a free port of
+# 127.0.0.1); its URI is HMPM_TEST_POSTGRES, and it is stopped at the end.
+pg_dir=$(mktemp -d /tmp/hmpm-pg.XXXXXX)
+trap 'bash scripts/postgres.sh stop "$pg_dir"' EXIT
+HMPM_TEST_POSTGRES=$(bash scripts/postgres.sh start "$pg_dir")
+export HMPM_TEST_POSTGRES
 stage ctest bash -c "cd build && ctest --output-on-failure -j $jobs --timeout 600"
 py=$(bash scripts/python.sh)
 stage python env HMPM_BUILD_DIR="$PWD/build" PYTHONPATH="$PWD/clients/python" \
   "$py" -m unittest discover -s tests/python -t . -v
+# The hostile suite: attacks on a live server (tests/hostile/run.py prints
+# faults survived, bad inputs tried, load held and anything lost).
+stage hostile env HMPM_BUILD_DIR="$PWD/build" "$py" tests/hostile/run.py
 # Selenium is Debian's python3-selenium: the system interpreter, not a venv.
 stage browser-embed /usr/bin/python3 tests/browser/check_embed.py
 stage browser env HMPM_BUILD_DIR="$PWD/build" /usr/bin/python3 tests/browser/test_dashboard.py

@@ -1,10 +1,13 @@
 // main.cpp — the hmpm-server executable: arguments, signals, one Service.
 //
 // SIGTERM and SIGINT are blocked in every thread and taken by a dedicated
-// thread with sigwait(), which asks the service to stop: it stops accepting,
-// puts running jobs back in the queue (they resume on the next start) and
-// run() returns, so the process exits 0. Exit 2 for bad arguments, 1 when
-// the database cannot be opened or the port cannot be bound.
+// thread with sigwait(), which asks the service to stop: no job is claimed
+// from then on, running jobs are cancelled and put back in the queue (they
+// resume on the next start), the listener closes, open connections get a
+// bounded drain (ServiceConfig::shutdown_drain_s) before their sockets are
+// shut down, and run() returns, so the process exits 0 with its store
+// closed. Exit 2 for bad arguments, 1 when the database cannot be opened or
+// the port cannot be bound.
 #include <pthread.h>
 #include <signal.h>
 
@@ -33,6 +36,13 @@ int main(int argc, char** argv) {
     return exit_status(ExitCode::server_usage);
   }
 
+  const hmpm::server::ServiceConfig& given = *parsed.config;
+  if (given.token.empty() && !hmpm::server::is_loopback_host(given.host)) {
+    std::cerr << "hmpm-server: WARNING: listening on " << given.host
+              << " without a token (--allow-no-token): anyone who can reach this address can "
+                 "submit, read and delete jobs\n";
+  }
+
   // Block the stop signals before any thread exists, so all threads inherit
   // the mask and only the signal thread below receives them.
   sigset_t stop_signals;
@@ -41,6 +51,9 @@ int main(int argc, char** argv) {
   sigaddset(&stop_signals, SIGINT);
   pthread_sigmask(SIG_BLOCK, &stop_signals, nullptr);
   signal(SIGPIPE, SIG_IGN);  // a client hanging up must not kill the server
+  // A file-size limit (RLIMIT_FSIZE) must not kill it either: ignored, the
+  // write fails with EFBIG like a full disk, and is handled as one.
+  signal(SIGXFSZ, SIG_IGN);
 
   try {
     // The machine speed behind the wall-time estimates of POST /validate

@@ -213,6 +213,10 @@ int command_run(const std::vector<std::string>& args) {
     return exit_run_failed;
   }
   if (tty) std::fputs("\n", stderr);
+  if (!outcome.write_error.empty()) {
+    std::cerr << "hmpm: could not write results: " << outcome.write_error << "\n";
+    return exit_run_failed;
+  }
   const hmpm::RunResult& r = outcome.run;
   for (const auto& w : r.warnings) std::cerr << "hmpm: warning: " << w << "\n";
   if (r.status != hmpm::RunStatus::successful) {

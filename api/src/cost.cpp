@@ -103,13 +103,19 @@ double grid_nodes(const Problem& p) {
   return nodes;
 }
 
+/// Solver threads a run of `particles` uses when given `threads`: as
+/// RunOptions::min_particles_per_thread decides in the solver.
+double solver_threads(double particles, int threads) {
+  const RunOptions defaults;
+  const double usable =
+      std::floor(particles / static_cast<double>(defaults.min_particles_per_thread));
+  return std::clamp(usable, 1.0, static_cast<double>(std::max(threads, 1)));
+}
+
 /// Expected wall time of `steps` steps of `scheme`.
 double wall_seconds(const Problem& p, Scheme scheme, double steps, const Calibration& cal) {
   const Work w = particle_work(p);
-  const RunOptions defaults;
-  const double usable =
-      std::floor(w.particles / static_cast<double>(defaults.min_particles_per_thread));
-  const double threads = std::clamp(usable, 1.0, static_cast<double>(std::max(cal.threads, 1)));
+  const double threads = solver_threads(w.particles, cal.threads);
   const double speedup = threads > 1 ? threads * WallModel::parallel_efficiency : 1.0;
   const double explicit_step = w.weighted / speedup + WallModel::step_overhead;
   const int d = std::clamp(p.dimension, 1, 3);
@@ -191,6 +197,71 @@ Scales scales(const Problem& p) {
 
 std::string fmt(double v) {
   return format_significant(v, 3);
+}
+
+// ------------------------------------------------------ the memory model
+// Bytes, from the solver's arrays (solver/src/state/): what each particle
+// and node holds, the nodal sums each extra solver thread keeps in a
+// private buffer of the whole grid, the series the run keeps until it ends
+// and one snapshot's arrays. Compared with the peak RSS of `hmpm run` in
+// docs/performance.md ("Memory estimate").
+struct MemoryModel {
+  /// The process itself, the spec and its parse, thread stacks touched.
+  static constexpr double base = 16.0 * (1 << 20);
+  /// Internal state variables per particle assumed for a plastic model.
+  static constexpr double plastic_state_variables = 4;
+  /// std::vector doubling: a series of n values holds up to 2n while it
+  /// grows (measured: 1.3n at the end of the runs of bench/memory.py).
+  static constexpr double growth = 2.0;
+  /// Set-up's temporaries per particle (initial positions for the
+  /// geostatic state and the formula checks, the geostatic columns).
+  static constexpr double setup_per_particle = 48;
+};
+
+bool any_fluid(const Problem& p) {
+  return std::any_of(p.materials.begin(), p.materials.end(),
+                     [](const Material& m) { return m.hydraulic.has_value(); });
+}
+
+double memory_bytes(const Problem& p, const CostEstimate& c, double threads) {
+  const double d = std::clamp(p.dimension, 1, 3);
+  const bool fluid = any_fluid(p);
+  const std::vector<const Material*> used = used_materials(p);
+  const bool plastic = std::any_of(used.begin(), used.end(), [](const Material* m) {
+    return !std::holds_alternative<LinearElastic>(m->plasticity);
+  });
+  // x, x0, v; mass, volume; stress, strain (Voigt); material, cell.
+  double particle = 8 * (3 * d + 2 + 12) + 2 + 4 * d;
+  if (p.shape_function == ShapeFunction::gimp) particle += 8;
+  if (fluid) particle += 8 * (3 + d);  // pressure, pressure_out, porosity, darcy
+  if (plastic) particle += 8 * MemoryModel::plastic_state_variables;
+  // Scattered sums (mass, momentum, force, remap; storage, pressure, flux)
+  // per node, in the grid and in every extra thread's buffer; the grid
+  // also keeps velocity and acceleration (and dp).
+  const double sums = 8 * (1 + 3 * d) + (fluid ? 24 : 0);
+  const double grid = sums + 16 * d + (fluid ? 8 : 0);
+  const double nodes = static_cast<double>(c.nodes);
+  const double particles = static_cast<double>(c.particles);
+  double bytes = MemoryModel::base + particles * (particle + MemoryModel::setup_per_particle) +
+                 nodes * (grid + (threads - 1) * sums);
+  // The series: every value of every row, kept until the end of the run.
+  const OutputRequest& o = p.output;
+  double per_row = 1;  // time
+  for (Field f : o.series_fields)
+    per_row += field_components(f, p.dimension) * static_cast<double>(o.series_particles.size());
+  if (c.series_rows > 0)
+    bytes += MemoryModel::growth * 8 * per_row * static_cast<double>(c.series_rows);
+  // One snapshot's arrays (3 components per vector, 6 per tensor), filled
+  // while the file is written.
+  if (c.snapshots > 0) {
+    double values = 2;  // volume, mass
+    if (o.snapshot_fields.empty())
+      for (const FieldInfo& f : field_table) values += field_components(f.field, 3);
+    else
+      for (Field f : o.snapshot_fields) values += field_components(f, 3);
+    bytes += particles * (8 * values + 4);
+  }
+  return bytes;
 }
 
 }  // namespace
@@ -293,7 +364,6 @@ CostEstimate estimate_cost(const Problem& p, const Calibration& calibration) {
   const double steps = static_cast<double>(step.steps);
   c.steps = step.steps;
   c.particle_steps = to_count(static_cast<double>(c.particles) * steps);
-  c.memory_bytes = to_count(400.0 * static_cast<double>(c.particles) + 100.0 * nodes);
   const OutputRequest& o = p.output;
   double rows = 0;
   if (!o.series_particles.empty() && !o.series_fields.empty())
@@ -319,6 +389,9 @@ CostEstimate estimate_cost(const Problem& p, const Calibration& calibration) {
       4096 + rows * (1 + series_values) * 2 * 22 +
       snaps * (static_cast<double>(c.particles) * (snapshot_values * 32.0 / 3.0 + 16) + 4096);
   c.output_bytes = to_count(bytes);
+  const double threads = solver_threads(static_cast<double>(c.particles), calibration.threads);
+  c.threads = static_cast<int>(threads);
+  c.memory_bytes = to_count(memory_bytes(p, c, threads));
 
   c.scheme = p.time.scheme;
   c.calibration = calibration;

@@ -3,7 +3,11 @@
 // Wraps hmpm::run: snapshots are written as the solver hands them over (the
 // .pvd collection is rewritten after each, so partial results are usable),
 // the series after the loop, summary.json last and always — also when the
-// run failed or a file could not be written.
+// run failed or a file could not be written (then the other files it wrote
+// are removed, so the listed files are exactly the ones left). Checkpoints
+// (options on_checkpoint) go to the caller as the solver takes them; a run
+// resumed from one (options.resume) keeps the snapshots already in out_dir,
+// lists them in the .pvd again and takes the series so far from the checkpoint.
 #include <algorithm>
 #include <stdexcept>
 
@@ -24,6 +28,16 @@ JobOutcome run_job(const ParsedJob& job, const fs::path& out_dir, const hmpm::Ru
   JobOutcome outcome;
   std::vector<std::pair<double, std::string>> snapshots;
   std::string write_error;
+  if (options.resume) {
+    try {  // the snapshots the interrupted run wrote before its checkpoint
+      const CheckpointInfo info =
+          inspect_checkpoint(job.problem, options.checkpoint_key, *options.resume);
+      for (std::size_t i = 0; i < info.snapshot_times.size(); ++i)
+        snapshots.emplace_back(info.snapshot_times[i], snapshot_file_name(static_cast<int>(i)));
+    } catch (const std::invalid_argument&) {
+      // hmpm::run refuses the checkpoint below, with the same message
+    }
+  }
   RunOptions opts = options;
   opts.on_snapshot = [&](const Snapshot& s) {
     const std::string name = snapshot_file_name(s.index);
@@ -63,10 +77,29 @@ JobOutcome run_job(const ParsedJob& job, const fs::path& out_dir, const hmpm::Ru
       outcome.run.message = std::string("could not write results: ") + e.what();
     }
   }
+  if (!write_error.empty()) {
+    // Partial results are removed: they hold the space a full disk needs,
+    // and a set of snapshots without the rest is no result.
+    for (const std::string& name : outcome.files) fs::remove(out_dir / name, ec);
+    outcome.run.message += "; the " + std::to_string(outcome.files.size()) +
+                           " result files written before were removed";
+    outcome.files.clear();
+    outcome.write_error = write_error;
+  }
   outcome.files.push_back("summary.json");
   std::sort(outcome.files.begin(), outcome.files.end());
-  write_summary(out_dir / "summary.json", job.name, outcome.run, job.cost, outcome.files);
-  if (!write_error.empty()) throw std::runtime_error(write_error);
+  try {
+    write_summary(out_dir / "summary.json", job.name, outcome.run, job.cost, outcome.files);
+  } catch (const std::runtime_error& e) {
+    if (outcome.write_error.empty()) {
+      for (const std::string& name : outcome.files) fs::remove(out_dir / name, ec);
+      outcome.write_error = e.what();
+      outcome.run.status = RunStatus::failed;
+      outcome.run.message = std::string("could not write results: ") + e.what();
+    }
+    fs::remove(out_dir / "summary.json", ec);
+    outcome.files.clear();
+  }
   return outcome;
 }
 

@@ -1,12 +1,16 @@
 # embed_sql.cmake — turns the migration files NNNN_name.sql of SQL_DIR into a
 # C++ header (OUTPUT) holding them as raw string literals, in file-name order,
 # so the server never reads a migration from disk at run time.
-# Usage: cmake -DSQL_DIR=dir -DOUTPUT=file.hpp -P embed_sql.cmake
+# Usage: cmake -DSQL_DIR=dir -DOUTPUT=file.hpp [-DNAMESPACE=sqlite] -P embed_sql.cmake
+# NAMESPACE is the store's namespace under hmpm::server (one header per store).
 include(${CMAKE_CURRENT_LIST_DIR}/write_if_changed.cmake)
+if(NOT NAMESPACE)
+  set(NAMESPACE sqlite)
+endif()
 file(GLOB files "${SQL_DIR}/*.sql")
 list(SORT files)
 set(text "// Generated from ${SQL_DIR} by server/cmake/embed_sql.cmake; do not edit.\n")
-string(APPEND text "#pragma once\n\nnamespace hmpm::server::sqlite {\n\n")
+string(APPEND text "#pragma once\n\nnamespace hmpm::server::${NAMESPACE} {\n\n")
 string(APPEND text "struct Migration {\n  int version;\n  const char* name;\n  const char* sql;\n};\n\n")
 string(APPEND text "inline constexpr Migration migrations[] = {\n")
 foreach(file IN LISTS files)
@@ -21,5 +25,5 @@ foreach(file IN LISTS files)
   endif()
   string(APPEND text "    {${version}, \"${name}\", R\"hmpm_sql(${sql})hmpm_sql\"},\n")
 endforeach()
-string(APPEND text "};\n\n}  // namespace hmpm::server::sqlite\n")
+string(APPEND text "};\n\n}  // namespace hmpm::server::${NAMESPACE}\n")
 write_if_changed("${OUTPUT}" "${text}")

@@ -22,6 +22,9 @@ void Metrics::observe_job(double seconds, JobStatus outcome) {
 
 std::string Metrics::render(const StatusCounts& counts, int workers) const {
   std::ostringstream out;
+  out << "# HELP hmpm_instance_info This server's instance id (the owner of its claims).\n"
+         "# TYPE hmpm_instance_info gauge\nhmpm_instance_info{instance=\""
+      << instance << "\"} 1\n";
   out << "# HELP hmpm_jobs Jobs in the store by status.\n# TYPE hmpm_jobs gauge\n";
   for (const auto& row : job_statuses) {
     const auto it = counts.find(row.status);
@@ -38,6 +41,13 @@ std::string Metrics::render(const StatusCounts& counts, int workers) const {
   out << "# HELP hmpm_event_streams Open Server-Sent Events streams.\n"
          "# TYPE hmpm_event_streams gauge\nhmpm_event_streams "
       << open_streams.load() << "\n";
+
+  out << "# HELP hmpm_claims_lost_total Writes refused because another server took the job "
+         "over.\n# TYPE hmpm_claims_lost_total counter\nhmpm_claims_lost_total "
+      << claims_lost.load() << "\n";
+  out << "# HELP hmpm_jobs_recovered_total Jobs with a lapsed lease this server took back.\n"
+         "# TYPE hmpm_jobs_recovered_total counter\nhmpm_jobs_recovered_total "
+      << recovered_jobs.load() << "\n";
 
   std::lock_guard<std::mutex> lock(mutex_);
   out << "# HELP hmpm_job_duration_seconds Wall time of finished job attempts.\n"

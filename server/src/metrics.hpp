@@ -1,8 +1,10 @@
 // metrics.hpp — counters for GET /metrics in the Prometheus text format.
 //
 // Request and job counters live in memory (they describe this process, as
-// Prometheus expects; a restart resets them). Job counts by status come from
-// the database at scrape time, so they survive restarts and never drift.
+// Prometheus expects; a restart resets them). Job counts by status and the
+// queue length come from the database at scrape time, so they survive
+// restarts, never drift, and are the same on every server sharing one
+// PostgreSQL database (hmpm_instance_info tells the servers apart).
 #pragma once
 
 #include <array>
@@ -26,6 +28,13 @@ class Metrics {
   std::atomic<int> open_streams{0};
   /// Jobs a worker is running right now.
   std::atomic<int> busy_workers{0};
+  /// Writes of this server refused because another claim replaced its own
+  /// (a takeover after its lease lapsed): the fencing at work.
+  std::atomic<int> claims_lost{0};
+  /// Jobs whose lapsed lease this server's recovery took back (requeued or failed).
+  std::atomic<int> recovered_jobs{0};
+  /// This server's instance id (claims carry it), set once at start-up.
+  std::string instance;
 
   /// The exposition text: `counts` are the jobs per status in the store.
   std::string render(const StatusCounts& counts, int workers) const;

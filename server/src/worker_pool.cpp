@@ -1,11 +1,19 @@
 // worker_pool.cpp — see worker_pool.hpp.
 #include "worker_pool.hpp"
 
+#include <fcntl.h>
+#include <unistd.h>
+
 #include <algorithm>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <iterator>
 #include <optional>
+#include <stdexcept>
 #include <system_error>
 
 #include "digest.hpp"
@@ -57,6 +65,97 @@ void remove_all_but_log(const std::filesystem::path& dir) {
   }
 }
 
+// Removes every file of `dir` that is neither the job's log nor one of
+// `listed` (the manifest): nothing stays in a job's folder that its manifest
+// does not show (the leftovers of a failed write hold space and are invisible).
+void remove_unlisted(const std::filesystem::path& dir, const std::vector<ResultFile>& listed) {
+  std::error_code ec;
+  for (const auto& entry : std::filesystem::directory_iterator(dir, ec)) {
+    const std::string name = entry.path().filename().string();
+    const bool kept =
+        name == run_log_name || std::any_of(listed.begin(), listed.end(),
+                                            [&](const ResultFile& f) { return f.name == name; });
+    if (!kept) std::filesystem::remove_all(entry.path(), ec);
+  }
+}
+
+// Checkpoint files: "checkpoint-<claim token>-<step>.hmpmck" (never a result file).
+constexpr const char* checkpoint_prefix = "checkpoint-";
+constexpr const char* checkpoint_suffix = ".hmpmck";
+
+bool is_checkpoint_file(const std::string& name) {
+  return name.rfind(checkpoint_prefix, 0) == 0;
+}
+
+// Removes the job's checkpoint files but `keep` (and any half-written one).
+void remove_checkpoints_but(const std::filesystem::path& dir, const std::string& keep = "") {
+  std::error_code ec;
+  for (const auto& entry : std::filesystem::directory_iterator(dir, ec)) {
+    const std::string name = entry.path().filename().string();
+    if (is_checkpoint_file(name) && name != keep) std::filesystem::remove(entry.path(), ec);
+  }
+}
+
+// Writes `bytes` to `path` durably: a temporary file, fsync, rename over
+// `path`, fsync of the folder. Throws std::runtime_error.
+void write_durably(const std::filesystem::path& path, const std::string& bytes) {
+  const std::string tmp = path.string() + ".tmp";
+  auto fail = [&](const char* what) {
+    const std::string message = std::string(what) + " " + tmp + ": " + std::strerror(errno);
+    ::unlink(tmp.c_str());
+    throw std::runtime_error(message);
+  };
+  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd < 0) fail("cannot create");
+  std::size_t done = 0;
+  while (done < bytes.size()) {
+    const ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) {
+      ::close(fd);
+      fail("cannot write");
+    }
+    done += static_cast<std::size_t>(n);
+  }
+  if (::fsync(fd) != 0) {
+    ::close(fd);
+    fail("cannot sync");
+  }
+  if (::close(fd) != 0) fail("cannot close");
+  if (::rename(tmp.c_str(), path.c_str()) != 0) fail("cannot rename");
+  const int dir = ::open(path.parent_path().c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (dir >= 0) {
+    ::fsync(dir);
+    ::close(dir);
+  }
+}
+
+// The bytes of the recorded checkpoint `rec` in `dir` when the file is
+// there, has the recorded SHA-256 and belongs to `job` (spec text `key`);
+// otherwise nullopt, with why in `why`.
+std::optional<std::string> read_checkpoint(const std::filesystem::path& dir,
+                                           const CheckpointRecord& rec,
+                                           const hmpm::api::ParsedJob& job, const std::string& key,
+                                           std::string& why) {
+  std::ifstream in(dir / rec.file, std::ios::binary);
+  if (!in) {
+    why = "its file " + rec.file + " is missing";
+    return std::nullopt;
+  }
+  std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (sha256_hex(bytes) != rec.sha256) {
+    why = "its file " + rec.file + " does not have the recorded SHA-256";
+    return std::nullopt;
+  }
+  try {
+    (void)hmpm::inspect_checkpoint(job.problem, key, bytes);
+  } catch (const std::invalid_argument& e) {
+    why = std::string("the solver refuses it: ") + e.what();
+    return std::nullopt;
+  }
+  return bytes;
+}
+
 // Size, SHA-256 and media type of each of `names` in `dir`, appended to
 // `files`; the name of the first one that cannot be read back, if any.
 std::optional<std::string> record_files(const std::filesystem::path& dir,
@@ -79,6 +178,27 @@ std::optional<std::string> record_files(const std::filesystem::path& dir,
 
 }  // namespace
 
+void log_recovery(const RecoveryReport& recovery) {
+  for (const auto& id : recovery.requeued) {
+    log_line({{"event", "job"},
+              {"job", id},
+              {"status", status_name(JobStatus::accepted)},
+              {"recovered", true}});
+  }
+  for (const auto& id : recovery.failed) {
+    log_line({{"event", "job"},
+              {"job", id},
+              {"status", status_name(JobStatus::failed)},
+              {"recovered", true},
+              {"reason", "too many interrupted attempts"}});
+  }
+}
+
+void WorkerPool::claim_lost(const std::string& id, double seconds) {
+  ++metrics_.claims_lost;
+  log_line({{"event", "job"}, {"job", id}, {"claim", "lost"}, {"seconds", seconds}});
+}
+
 void WorkerPool::end_dismissed(const JobRecord& job, const Claim& claim,
                                const std::vector<std::string>& written, double seconds) {
   const std::filesystem::path dir = job_dir(job.id);
@@ -86,17 +206,19 @@ void WorkerPool::end_dismissed(const JobRecord& job, const Claim& claim,
   record_files(dir, written, files);
   ClaimState state = ClaimState::lost;
   try {
-    state = store_.keep_results(claim, files, seconds);
-  } catch (const std::exception& e) {
+    state = with_retries(job.id, "keep_results",
+                         [&] { return store_.keep_results(claim, files, seconds); });
+  } catch (const std::exception& e) {  // shutting down: the next start recovers the job
     log_line({{"event", "store_error"}, {"job", job.id}, {"detail", e.what()}});
   }
   if (state == ClaimState::lost) {  // not ours any more: touch nothing
-    log_line({{"event", "job"}, {"job", job.id}, {"claim", "lost"}, {"seconds", seconds}});
+    claim_lost(job.id, seconds);
     return;
   }
   const bool kept = state == ClaimState::held;
   std::error_code ec;
   if (kept) {
+    remove_checkpoints_but(dir);
     append_run_log(dir, "cancelled after " + short_number(seconds) + " s wall; " +
                             std::to_string(files.size()) + " result files kept");
   } else {
@@ -129,12 +251,23 @@ void WorkerPool::heartbeat() {
     heartbeat_wake_.wait_for(lock, std::chrono::duration<double>(settings_.lease_renewal_s),
                              [&] { return stopping_; });
     if (stopping_) return;
-    if (running_.empty()) continue;
+    const bool busy = !running_.empty();
     lock.unlock();
     try {
-      store_.renew_leases(settings_.claimant);
+      if (busy) store_.renew_leases(settings_.claimant);
     } catch (const std::exception& e) {
       log_line({{"event", "store_error"}, {"detail", e.what()}, {"during", "lease renewal"}});
+    }
+    try {
+      // Takes over the jobs of servers whose lease lapsed (on one SQLite
+      // file there are none: the lock voided them at start-up).
+      const RecoveryReport report =
+          store_.recover(settings_.max_attempts, settings_.charge_after_s);
+      log_recovery(report);
+      metrics_.recovered_jobs += static_cast<int>(report.requeued.size() + report.failed.size());
+      for (std::size_t i = 0; i < report.requeued.size(); ++i) notify();
+    } catch (const std::exception& e) {
+      log_line({{"event", "store_error"}, {"detail", e.what()}, {"during", "recovery"}});
     }
     lock.lock();
   }
@@ -159,17 +292,46 @@ bool WorkerPool::cancel(const std::string& id, double wait_s) {
   return true;
 }
 
-void WorkerPool::shutdown() {
-  std::vector<std::thread> threads;
+void WorkerPool::stop_claiming() {
   {
     std::lock_guard<std::mutex> lock(mutex_);
     stopping_ = true;
     for (auto& [id, running] : running_) running->cancel = true;
-    threads.swap(threads_);
-    if (heartbeat_.joinable()) threads.push_back(std::move(heartbeat_));
   }
   wake_.notify_all();
   heartbeat_wake_.notify_all();
+  retry_wake_.notify_all();
+}
+
+ClaimState WorkerPool::with_retries(const std::string& id, const char* during,
+                                    const std::function<ClaimState()>& write) {
+  double wait_s = first_retry_s;
+  for (int attempt = 1;; ++attempt) {
+    try {
+      return write();
+    } catch (const StoreFailure& e) {
+      std::unique_lock<std::mutex> lock(mutex_);
+      log_line({{"event", "store_error"},
+                {"job", id},
+                {"during", during},
+                {"attempt", attempt},
+                {"detail", e.what()},
+                {"retry_in_s", stopping_ ? 0.0 : wait_s}});
+      if (stopping_) throw;  // the job stays running; recovery at the next start requeues it
+      retry_wake_.wait_for(lock, std::chrono::duration<double>(wait_s), [&] { return stopping_; });
+      wait_s = std::min(2 * wait_s, last_retry_s);
+    }
+  }
+}
+
+void WorkerPool::shutdown() {
+  stop_claiming();
+  std::vector<std::thread> threads;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    threads.swap(threads_);
+    if (heartbeat_.joinable()) threads.push_back(std::move(heartbeat_));
+  }
   for (auto& t : threads) t.join();
 }
 
@@ -232,16 +394,46 @@ void WorkerPool::run_one(const JobRecord& job, Running& running) {
   const Claim claim = claim_of(job);
   log_transition(job.id, JobStatus::running, {{"attempt", job.attempts}});
   const std::filesystem::path dir = job_dir(job.id);
-  remove_all_but_log(dir);  // leftovers of an interrupted attempt
+  auto parsed = hmpm::api::parse_job(job.spec, settings_.limits);
+  // An earlier attempt's checkpoint: resume from it when it is intact, else
+  // start afresh (the folder then loses that attempt's leftovers).
+  std::optional<std::string> resume;
+  std::string checkpoint_file;  // the recorded checkpoint of this job, if any
+  std::optional<CheckpointRecord> recorded;
+  try {
+    recorded = store_.checkpoint(job.id);
+  } catch (const std::exception& e) {
+    log_line({{"event", "store_error"}, {"job", job.id}, {"detail", e.what()}});
+  }
+  if (recorded && parsed.ok() && settings_.checkpoint_interval_s > 0) {
+    std::string why;
+    resume = read_checkpoint(dir, *recorded, *parsed.job, job.spec, why);
+    if (!resume) {
+      append_run_log(dir, "checkpoint at step " + std::to_string(recorded->step) + " not usable (" +
+                              why + "): starting from step 0");
+      log_line({{"event", "checkpoint"}, {"job", job.id}, {"unusable", why}});
+    }
+  }
+  if (resume) {
+    checkpoint_file = recorded->file;
+    remove_checkpoints_but(dir, checkpoint_file);  // the snapshots so far stay
+  } else {
+    remove_all_but_log(dir);  // leftovers of an interrupted attempt
+  }
   append_run_log(dir, "attempt " + std::to_string(job.attempts) + " started on " +
                           settings_.claimant.instance + ": " + std::to_string(job.cost.particles) +
                           " particles, " + std::to_string(job.cost.steps) + " steps, " +
                           std::to_string(settings_.threads_per_job) + " solver threads");
+  if (resume) {
+    append_run_log(dir, "resumed from the checkpoint at step " + std::to_string(recorded->step) +
+                            ", t = " + short_number(recorded->time) + " s (" + recorded->file +
+                            ", written " + recorded->written + ")");
+    log_line({{"event", "checkpoint"}, {"job", job.id}, {"resumed_step", recorded->step}});
+  }
 
   JobStatus outcome = JobStatus::failed;
   std::string reason;
   hmpm::api::JobOutcome result;
-  auto parsed = hmpm::api::parse_job(job.spec, settings_.limits);
   if (!parsed.ok()) {
     reason = "the stored spec is no longer valid: " + describe(parsed.errors);
   } else {
@@ -280,6 +472,46 @@ void WorkerPool::run_one(const JobRecord& job, Running& running) {
         log_line({{"event", "store_error"}, {"job", job.id}, {"detail", e.what()}});
       }
     };
+    options.checkpoint_key = job.spec;
+    options.checkpoint_interval_s = settings_.checkpoint_interval_s;
+    if (resume) options.resume = &*resume;
+    if (settings_.checkpoint_interval_s > 0) {
+      options.on_checkpoint = [&](const hmpm::Checkpoint& c) {
+        // The solver's last checkpoint of a cancelled run is kept for a
+        // shutdown only (a dismissed job, or one another claim took, is over).
+        if (running.dismissed || running.lost) return;
+        const auto t1 = SteadyClock::now();
+        const std::string name = checkpoint_prefix + std::to_string(claim.token) + "-" +
+                                 std::to_string(c.step) + checkpoint_suffix;
+        try {
+          write_durably(dir / name, c.bytes);
+          const CheckpointRecord rec{
+              name, c.step, c.time, static_cast<std::int64_t>(c.bytes.size()), sha256_hex(c.bytes),
+              ""};
+          const ClaimState state = store_.record_checkpoint(claim, rec);
+          if (state != ClaimState::held) {  // not ours to record: stop, as for progress
+            std::error_code ec;
+            std::filesystem::remove(dir / name, ec);
+            running.dismissed = state == ClaimState::dismissed;
+            running.lost = state == ClaimState::lost;
+            running.cancel = true;
+            return;
+          }
+          if (!checkpoint_file.empty() && checkpoint_file != name) {
+            std::error_code ec;
+            std::filesystem::remove(dir / checkpoint_file, ec);
+          }
+          checkpoint_file = name;
+          append_run_log(dir, "checkpoint at step " + std::to_string(c.step) + ", t = " +
+                                  short_number(c.time) + " s: " + std::to_string(c.bytes.size()) +
+                                  " bytes in " + short_number(seconds_since(t1)) + " s");
+        } catch (const std::exception& e) {  // the run goes on; the last checkpoint stays
+          std::error_code ec;
+          std::filesystem::remove(dir / name, ec);
+          log_line({{"event", "checkpoint_error"}, {"job", job.id}, {"detail", e.what()}});
+        }
+      };
+    }
     try {
       std::filesystem::create_directories(dir);
       result = hmpm::api::run_job(*parsed.job, dir, options);
@@ -297,7 +529,7 @@ void WorkerPool::run_one(const JobRecord& job, Running& running) {
   const double seconds = seconds_since(t0);
 
   if (running.lost) {  // another instance owns the job and its folder now
-    log_line({{"event", "job"}, {"job", job.id}, {"claim", "lost"}, {"seconds", seconds}});
+    claim_lost(job.id, seconds);
     return;
   }
   if (running.dismissed) {
@@ -305,15 +537,21 @@ void WorkerPool::run_one(const JobRecord& job, Running& running) {
     return;
   }
   if (running.cancel && outcome != JobStatus::successful) {  // shutdown: run it again next start
-    const ClaimState state = store_.requeue(claim);
+    const ClaimState state = with_retries(job.id, "requeue", [&] { return store_.requeue(claim); });
     if (state == ClaimState::dismissed) return end_dismissed(job, claim, result.files, seconds);
     if (state == ClaimState::lost) {
-      log_line({{"event", "job"}, {"job", job.id}, {"claim", "lost"}, {"seconds", seconds}});
+      claim_lost(job.id, seconds);
       return;
     }
-    remove_all_but_log(dir);
-    append_run_log(dir, "stopped after " + short_number(seconds) +
-                            " s: the server is shutting down; queued again");
+    if (checkpoint_file.empty()) {
+      remove_all_but_log(dir);
+      append_run_log(dir, "stopped after " + short_number(seconds) +
+                              " s: the server is shutting down; queued again");
+    } else {  // the next attempt resumes from the checkpoint and the snapshots before it
+      append_run_log(dir, "stopped after " + short_number(seconds) +
+                              " s: the server is shutting down; queued again, to resume from " +
+                              checkpoint_file);
+    }
     log_transition(job.id, JobStatus::accepted, {{"requeued", true}, {"seconds", seconds}});
     return;
   }
@@ -323,13 +561,19 @@ void WorkerPool::run_one(const JobRecord& job, Running& running) {
     outcome = JobStatus::failed;
     reason = "result file " + *unreadable + " could not be read back";
   }
+  remove_unlisted(dir, files);
   const std::string message = outcome == JobStatus::successful ? "finished" : reason;
-  const ClaimState state = store_.finish(claim, JobEnd{outcome, message, reason, files, seconds});
+  // The end of a job must reach the store, or it would stay running until a
+  // restart: a failing write (disk full) is retried with backoff.
+  const ClaimState state = with_retries(job.id, "finish", [&] {
+    return store_.finish(claim, JobEnd{outcome, message, reason, files, seconds});
+  });
   if (state == ClaimState::lost) {  // taken over while finishing: the files are not ours
-    log_line({{"event", "job"}, {"job", job.id}, {"claim", "lost"}, {"seconds", seconds}});
+    claim_lost(job.id, seconds);
     return;
   }
   if (state == ClaimState::dismissed) return end_dismissed(job, claim, result.files, seconds);
+  remove_checkpoints_but(dir);  // the job has ended: its checkpoints are of no use now
   append_run_log(dir, std::string(status_name(outcome)) + " after " + short_number(seconds) +
                           " s wall, " + std::to_string(files.size()) + " result files" +
                           (reason.empty() ? "" : ": " + reason));

@@ -15,13 +15,17 @@
 // Every job is claimed for this process's instance (`WorkerSettings::claimant`);
 // a heartbeat thread renews the leases of the running jobs every
 // `lease_renewal_s`, and a worker whose claim was lost stops without touching
-// the job's files (another instance owns them now).
+// the job's files (another instance owns them now). The same heartbeat runs
+// recovery (JobStore::recover), so the jobs of a server that died while
+// others share its database are taken over once their lease lapses, not
+// only when a server starts.
 #pragma once
 
 #include <atomic>
 #include <condition_variable>
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -44,7 +48,15 @@ struct WorkerSettings {
   hmpm::api::Limits limits;
   Claimant claimant;              ///< this process's instance id and lease length
   double lease_renewal_s = 10.0;  ///< heartbeat period; well under claimant.lease_s
+  /// Wall time between checkpoints of a running job (its solver state, from
+  /// which a later attempt resumes); <= 0: none.
+  double checkpoint_interval_s = 60.0;
+  int max_attempts = 3;          ///< recover(): starts of a job before it fails
+  double charge_after_s = 30.0;  ///< recover(): see ServiceConfig::charge_after_s
 };
+
+/// One log line per job that recovery requeued or failed.
+void log_recovery(const RecoveryReport& recovery);
 
 class WorkerPool {
  public:
@@ -60,8 +72,10 @@ class WorkerPool {
   /// to `wait_s` for the worker to let go of the job (its files recorded or
   /// removed). Returns whether a worker of this process was running it.
   bool cancel(const std::string& id, double wait_s = 0.0);
-  /// Stops taking jobs, cancels the running ones, puts them back in the
-  /// queue and joins the threads. Idempotent.
+  /// Stops taking jobs and asks the running ones to stop; each worker puts
+  /// its job back in the queue and ends. Returns at once. Idempotent.
+  void stop_claiming();
+  /// stop_claiming(), then joins the threads. Idempotent.
   void shutdown();
 
   /// Where the result files of job `id` live.
@@ -76,10 +90,20 @@ class WorkerPool {
   void work();
   void heartbeat();
   void run_one(const JobRecord& job, Running& running);
+  // A write of `id` was refused: another claim replaced ours (counted, logged).
+  void claim_lost(const std::string& id, double seconds);
   // The end of a dismissed run: keeps the files it `written` if the job was
   // cancelled, removes them if it was deleted (the store decides).
   void end_dismissed(const JobRecord& job, const Claim& claim,
                      const std::vector<std::string>& written, double seconds);
+  // A write that ends a job's attempt (finish, requeue, keep_results): a
+  // StoreFailure (disk full, I/O error) is logged and the write retried after
+  // first_retry_s, doubling up to last_retry_s, until it succeeds or the pool
+  // stops (then the failure is rethrown and start-up recovery deals with it).
+  ClaimState with_retries(const std::string& id, const char* during,
+                          const std::function<ClaimState()>& write);
+  static constexpr double first_retry_s = 0.1;
+  static constexpr double last_retry_s = 5.0;
 
   JobStore& store_;
   Metrics& metrics_;
@@ -88,6 +112,7 @@ class WorkerPool {
   std::condition_variable wake_;            ///< workers: a job was queued, or stop
   std::condition_variable heartbeat_wake_;  ///< the heartbeat thread: stop
   std::condition_variable job_done_;        ///< a worker let go of a job
+  std::condition_variable retry_wake_;      ///< a worker retrying a store write: stop
   bool stopping_ = false;
   std::uint64_t generation_ = 0;  ///< bumped by notify()
   std::map<std::string, std::shared_ptr<Running>> running_;

@@ -4,11 +4,13 @@
 // hot loops only on the failure path (strings are built there only).
 #pragma once
 
+#include <cmath>
 #include <mutex>
 #include <string>
 #include <utility>
 
 #include "hmpm/format.hpp"
+#include "hmpm/run.hpp"
 #include "simulation.hpp"
 
 namespace hmpm {
@@ -62,6 +64,39 @@ void Simulation<Dim, Shape>::fail_volume(std::size_t p, double j) {
                      number(j) + " in one step)",
                  "reduce time.dt or time.courant, refine the grid, or use a gimp/bspline "
                  "shape_function for large deformations");
+}
+
+template <int Dim, class Shape>
+bool Simulation<Dim, Shape>::loads_finite_at(double t) {
+  // The first value that is not finite, with its place in the spec.
+  const auto check = [&](const FieldOfTime* f, const Location& where) {
+    if (!f || !*f) return true;
+    const double v = (*f)(t);
+    if (std::isfinite(v)) return true;
+    const std::string value = std::isnan(v) ? "NaN" : (v > 0 ? "+infinity" : "-infinity");
+    fail_run("the formula at /" + where.text() + " gave " + value + " at t = " + number(t) +
+                 " s (a load or boundary value, not the solution diverging)",
+             "make the formula at /" + where.text() +
+                 " finite at every time from 0 to time.end (a spec's formulas are checked at "
+                 "1001 instants before the run; this time lies between them)");
+    return false;
+  };
+  for (std::size_t i = 0; i < problem_.tractions.size(); ++i)
+    for (int a = 0; a < Dim; ++a)
+      if (!check(&problem_.tractions[i].traction[a],
+                 Location{"tractions"} / i / "traction" / static_cast<std::size_t>(a)))
+        return false;
+  for (std::size_t i = 0; i < problem_.boundaries.size(); ++i) {
+    const Boundary& b = problem_.boundaries[i];
+    for (int a = 0; a < Dim; ++a)
+      if (b.velocity[a] && !check(&*b.velocity[a], Location{"boundaries"} / i / "velocity" /
+                                                       static_cast<std::size_t>(a)))
+        return false;
+    if (fluid_ && b.pore_pressure &&
+        !check(&*b.pore_pressure, Location{"boundaries"} / i / "pore_pressure"))
+      return false;
+  }
+  return true;
 }
 
 template <int Dim, class Shape>

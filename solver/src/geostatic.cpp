@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "hmpm/format.hpp"
+#include "interrupt.hpp"
 #include "materials/material.hpp"
 #include "particle_layout.hpp"
 
@@ -43,17 +44,17 @@ Vertical vertical_of(const Problem& problem) {
   return v;
 }
 
-std::vector<BodyExtent> body_extents(const Problem& problem) {
+std::vector<BodyExtent> body_extents(const Problem& problem,
+                                     const std::vector<BodyLayout>& layouts) {
   std::vector<BodyExtent> out;
-  for (const Body& body : problem.bodies) {
+  for (std::size_t b = 0; b < problem.bodies.size(); ++b) {
+    const Body& body = problem.bodies[b];
     BodyExtent e;
-    const BodyLayout layout = body_layout(problem, body);
+    const BodyLayout& layout = layouts[b];
     e.empty = layout.count == 0;
     for (int a = 0; a < problem.dimension && !e.empty; ++a) {
-      const double h = (problem.grid.max[a] - problem.grid.min[a]) / problem.grid.cells[a];
-      const double half = 0.5 * h / std::max(body.particles_per_cell, 1);
-      e.lo[a] = layout.coords[a].front() - half;
-      e.hi[a] = layout.coords[a].back() + half;
+      e.lo[a] = layout.lo[a];
+      e.hi[a] = layout.hi[a];
     }
     if (body.material >= 0 && body.material < static_cast<int>(problem.materials.size())) {
       const Material& m = problem.materials[static_cast<std::size_t>(body.material)];
@@ -129,7 +130,8 @@ std::vector<ProblemIssue> check_geostatic(const Problem& problem) {
                             "pressure)"});
     if (!fluid) fluid = &m;
   }
-  const std::vector<BodyExtent> extents = body_extents(problem);
+  const std::vector<BodyLayout> layouts = body_layouts(problem);
+  const std::vector<BodyExtent> extents = body_extents(problem, layouts);
   const int dim = problem.dimension;
   const char* axis_name[] = {"x", "y", "z"};
   for (std::size_t b = 0; b < extents.size(); ++b) {
@@ -154,40 +156,28 @@ std::vector<ProblemIssue> check_geostatic(const Problem& problem) {
                "material without 'hydraulic' (with the bulk density of the unsaturated soil)"});
     // The table must not lie above the ground surface of any column through
     // this body: free water above the ground is not modelled.
-    const BodyLayout layout = body_layout(problem, problem.bodies[b]);
-    const std::vector<double> none{0.0};
-    const std::vector<double>& xs = v.axis == 0 ? none : layout.coords[0];
-    const std::vector<double>& ys = (dim < 2 || v.axis == 1) ? none : layout.coords[1];
-    const std::vector<double>& zs = (dim < 3 || v.axis == 2) ? none : layout.coords[2];
-    bool reported = false;
-    for (double z : zs) {
-      for (double y : ys) {
-        for (double x : xs) {
-          const Vec3 at{x, y, z};
-          const double surface = surface_at(extents, at, v, dim);
-          if (table > surface + tol) {
-            issues.push_back({where / "water_table",
-                              "is " + fmt(*geo.water_table) + ", above the ground surface " +
-                                  axis_name[v.axis] + " = " + fmt(v.up * surface) + " over " +
-                                  body +
-                                  ": free water above the ground is not modelled; lower the table "
-                                  "to the surface and load the surface with a traction instead"});
-            reported = true;
-            break;
-          }
-        }
-        if (reported) break;
+    // Every particle's column (one per distinct horizontal position would
+    // do; the first violation is reported).
+    for (const Vec3& at : layouts[b].positions) {
+      const double surface = surface_at(extents, at, v, dim);
+      if (table > surface + tol) {
+        issues.push_back({where / "water_table",
+                          "is " + fmt(*geo.water_table) + ", above the ground surface " +
+                              axis_name[v.axis] + " = " + fmt(v.up * surface) + " over " + body +
+                              ": free water above the ground is not modelled; lower the table "
+                              "to the surface and load the surface with a traction instead"});
+        break;
       }
-      if (reported) break;
     }
   }
   return issues;
 }
 
-GeostaticState geostatic_state(const Problem& problem) {
+GeostaticState geostatic_state(const Problem& problem, const SetupInterrupt* interrupt) {
   const Geostatic& geo = *problem.initial_state.geostatic;
   const Vertical v = vertical_of(problem);
-  const std::vector<BodyExtent> extents = body_extents(problem);
+  const std::vector<BodyLayout> layouts = body_layouts(problem);
+  const std::vector<BodyExtent> extents = body_extents(problem, layouts);
   const int dim = problem.dimension;
   GeostaticState out;
   out.vertical_axis = v.axis;
@@ -202,8 +192,9 @@ GeostaticState geostatic_state(const Problem& problem) {
     const std::size_t mat = static_cast<std::size_t>(problem.bodies[b].material);
     double k0 = geo.k0.value_or(m.poisson_ratio / (1.0 - m.poisson_ratio));
     if (mat < geo.material_k0.size() && geo.material_k0[mat]) k0 = *geo.material_k0[mat];
-    const std::int64_t count = body_layout(problem, problem.bodies[b]).count;
+    const std::int64_t count = layouts[b].count;
     for (std::int64_t k = 0; k < count; ++k, ++p) {
+      if (interrupt) interrupt->poll(p);
       const Vec3& x = positions[p];
       const double elevation = v.up * x[v.axis];
       // Weight of the column above the particle, per unit area.

@@ -17,6 +17,8 @@
 
 namespace hmpm {
 
+class SetupInterrupt;
+
 /// Per particle (global numbering), compression negative, Pa.
 struct GeostaticState {
   int vertical_axis = 0;
@@ -32,7 +34,8 @@ struct GeostaticState {
 std::vector<ProblemIssue> check_geostatic(const Problem& problem);
 
 /// The state at every particle. Requires check_geostatic(problem) to be empty.
-GeostaticState geostatic_state(const Problem& problem);
+/// `interrupt`, when given, is polled once per particle (set-up's stop checks).
+GeostaticState geostatic_state(const Problem& problem, const SetupInterrupt* interrupt = nullptr);
 
 /// Sets particle stress (Voigt, `dim` active axes) from a geostatic state:
 /// helper shared by the solver's set-up for all dimensions.

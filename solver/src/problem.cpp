@@ -7,6 +7,7 @@
 #include <limits>
 #include <stdexcept>
 
+#include "geometry/polygon.hpp"
 #include "geostatic.hpp"
 #include "hmpm/format.hpp"
 #include "hmpm/problem.hpp"
@@ -31,45 +32,222 @@ const char* status_name(RunStatus s) {
 
 // ---------------------------------------------------------------- layout
 
-BodyLayout body_layout(const Problem& problem, const Body& body) {
-  BodyLayout layout;
+namespace {
+
+using geometry::Point2;
+
+/// Cell size along axis a.
+double cell_size(const Problem& problem, int a) {
+  return (problem.grid.max[a] - problem.grid.min[a]) / problem.grid.cells[a];
+}
+
+/// Tolerance of "on the boundary" for filling: far below any sub-cell spacing.
+double fill_tolerance(const Problem& problem) {
+  return 1e-9 * min_cell_size(problem);
+}
+
+/// The plane axes of a prism's polygon: the other two axes in order.
+std::array<int, 2> plane_axes(int axis) {
+  if (axis == 0) return {1, 2};
+  if (axis == 1) return {0, 2};
+  return {0, 1};
+}
+
+/// Whether x lies in a polygon or prism body's shape (or on its boundary).
+bool in_polygon_shape(const Body& body, const Vec3& x, double tol) {
+  if (body.polygon) return geometry::inside_or_on(body.polygon->vertices, {x[0], x[1]}, tol);
+  const Prism& prism = *body.prism;
+  if (x[prism.axis] < prism.from - tol || x[prism.axis] > prism.to + tol) return false;
+  const auto [u, v] = plane_axes(prism.axis);
+  return geometry::inside_or_on(prism.polygon.vertices, {x[u], x[v]}, tol);
+}
+
+/// The bounding box of a polygon or prism body's shape (a box body: its box).
+Box shape_box(const Body& body) {
+  Box out = body.box;
+  if (!body.polygon && !body.prism) return out;
+  const std::vector<Point2>& poly =
+      body.polygon ? body.polygon->vertices : body.prism->polygon.vertices;
+  if (poly.empty()) return out;
+  const auto [lo, hi] = geometry::bounds(poly);
+  const std::array<int, 2> uv =
+      body.polygon ? std::array<int, 2>{0, 1} : plane_axes(body.prism->axis);
+  for (int k = 0; k < 2; ++k) {
+    out.min[uv[k]] = lo[k];
+    out.max[uv[k]] = hi[k];
+  }
+  if (body.prism) {
+    out.min[body.prism->axis] = body.prism->from;
+    out.max[body.prism->axis] = body.prism->to;
+  }
+  return out;
+}
+
+bool in_box(const Box& box, const Vec3& x, int dim, double tol) {
+  for (int a = 0; a < dim; ++a)
+    if (x[a] < box.min[a] - tol || x[a] > box.max[a] + tol) return false;
+  return true;
+}
+
+/// Per axis, the sub-cell centres a lattice body may fill: of the whole
+/// cells inside a box, or of every cell meeting a polygon's or prism's
+/// bounding box.
+std::array<std::vector<double>, 3> lattice_coords(const Problem& problem, const Body& body) {
   const int ppc = std::max(body.particles_per_cell, 1);
+  const Box range = shape_box(body);
+  const bool whole_cells = !body.polygon && !body.prism;
+  std::array<std::vector<double>, 3> coords;
   for (int a = 0; a < 3; ++a) {
-    layout.coords[a].clear();
     if (a >= problem.dimension) {
-      layout.coords[a].push_back(0.0);
+      coords[a].push_back(0.0);
       continue;
     }
-    const double h = (problem.grid.max[a] - problem.grid.min[a]) / problem.grid.cells[a];
+    const double h = cell_size(problem, a);
     const double tol = 1e-9 * h;
     for (int c = 0; c < problem.grid.cells[a]; ++c) {
       const double lo = problem.grid.min[a] + c * h;
       const double hi = lo + h;
-      if (lo < body.box.min[a] - tol || hi > body.box.max[a] + tol) continue;
-      for (int k = 0; k < ppc; ++k) layout.coords[a].push_back(lo + (k + 0.5) * h / ppc);
+      if (whole_cells && (lo < range.min[a] - tol || hi > range.max[a] + tol)) continue;
+      if (!whole_cells && (hi < range.min[a] - tol || lo > range.max[a] + tol)) continue;
+      for (int k = 0; k < ppc; ++k) {
+        const double x = lo + (k + 0.5) * h / ppc;
+        if (whole_cells || (x >= range.min[a] - tol && x <= range.max[a] + tol))
+          coords[a].push_back(x);
+      }
     }
   }
-  layout.count = static_cast<std::int64_t>(layout.coords[0].size()) *
-                 static_cast<std::int64_t>(layout.coords[1].size()) *
-                 static_cast<std::int64_t>(layout.coords[2].size());
-  return layout;
+  return coords;
+}
+
+/// Whether an earlier box, polygon or prism body (its layout `earlier`,
+/// its shape's bounding box `bounds`) owns position x: a box owns the whole
+/// cells it fills, a polygon or prism its shape.
+bool claims(const Problem& problem, const Body& body, const BodyLayout& earlier, const Box& bounds,
+            const Vec3& x, double tol) {
+  if (earlier.count == 0) return false;
+  if (body.polygon || body.prism)
+    return in_box(bounds, x, problem.dimension, tol) && in_polygon_shape(body, x, tol);
+  const Box filled{earlier.lo, earlier.hi};
+  return in_box(filled, x, problem.dimension, tol);
+}
+
+/// Whether two positions coincide (within tol per axis).
+bool same_place(const Vec3& a, const Vec3& b, double tol) {
+  return std::abs(a[0] - b[0]) <= tol && std::abs(a[1] - b[1]) <= tol &&
+         std::abs(a[2] - b[2]) <= tol;
+}
+
+}  // namespace
+
+std::vector<BodyLayout> body_layouts(const Problem& problem) {
+  std::vector<BodyLayout> layouts(problem.bodies.size());
+  const double tol = fill_tolerance(problem);
+  const int dim = problem.dimension;
+  // Every points body's positions sorted by x, to find coincident ones.
+  std::vector<std::vector<Vec3>> sorted_points(problem.bodies.size());
+  std::vector<Box> bounds;
+  for (const Body& body : problem.bodies) bounds.push_back(shape_box(body));
+  double cell_volume = 1.0;
+  for (int a = 0; a < dim; ++a) cell_volume *= cell_size(problem, a);
+  for (std::size_t b = 0; b < problem.bodies.size(); ++b) {
+    const Body& body = problem.bodies[b];
+    BodyLayout& layout = layouts[b];
+    std::vector<std::int64_t> lost(b, 0);
+    auto keep = [&](const Vec3& x, double volume) {
+      for (std::size_t e = 0; e < b; ++e) {
+        bool owned = false;
+        if (problem.bodies[e].points) {
+          const std::vector<Vec3>& pts = sorted_points[e];
+          auto it = std::lower_bound(pts.begin(), pts.end(), x[0] - tol,
+                                     [](const Vec3& p, double v) { return p[0] < v; });
+          for (; it != pts.end() && (*it)[0] <= x[0] + tol && !owned; ++it)
+            owned = same_place(*it, x, tol);
+        } else {
+          owned = claims(problem, problem.bodies[e], layouts[e], bounds[e], x, tol);
+        }
+        if (owned) {
+          ++lost[e];
+          return;
+        }
+      }
+      layout.positions.push_back(x);
+      layout.volumes.push_back(volume);
+    };
+    if (body.points) {
+      const ParticleList& pl = *body.points;
+      for (std::size_t k = 0; k < pl.positions.size(); ++k)
+        keep(pl.positions[k], k < pl.volumes.size() ? pl.volumes[k] : 0.0);
+    } else {
+      const std::array<std::vector<double>, 3> coords = lattice_coords(problem, body);
+      const bool shaped = body.polygon || body.prism;
+      const double v0 = cell_volume / std::pow(std::max(body.particles_per_cell, 1), dim);
+      for (double z : coords[2])
+        for (double y : coords[1])
+          for (double x : coords[0]) {
+            const Vec3 x3{x, y, z};
+            if (!shaped || in_polygon_shape(body, x3, tol)) keep(x3, v0);
+          }
+    }
+    layout.count = static_cast<std::int64_t>(layout.positions.size());
+    for (std::size_t e = 0; e < b; ++e)
+      if (lost[e] > 0) layout.lost.emplace_back(e, lost[e]);
+    // The space filled: each particle's own cell (sub-cell, or the cube of
+    // its volume for a points body).
+    for (int a = 0; a < dim; ++a) {
+      layout.lo[a] = std::numeric_limits<double>::infinity();
+      layout.hi[a] = -std::numeric_limits<double>::infinity();
+    }
+    for (std::size_t k = 0; k < layout.positions.size(); ++k) {
+      const double half =
+          body.points ? 0.5 * std::pow(std::max(layout.volumes[k], 0.0), 1.0 / dim) : 0.0;
+      for (int a = 0; a < dim; ++a) {
+        const double ha =
+            body.points ? half : 0.5 * cell_size(problem, a) / std::max(body.particles_per_cell, 1);
+        layout.lo[a] = std::min(layout.lo[a], layout.positions[k][a] - ha);
+        layout.hi[a] = std::max(layout.hi[a], layout.positions[k][a] + ha);
+      }
+    }
+    if (body.points) {
+      sorted_points[b] = layout.positions;
+      std::sort(sorted_points[b].begin(), sorted_points[b].end(),
+                [](const Vec3& p, const Vec3& q) { return p[0] < q[0]; });
+    }
+  }
+  return layouts;
 }
 
 std::int64_t count_particles(const Problem& problem) {
   std::int64_t n = 0;
-  for (const Body& b : problem.bodies) n += body_layout(problem, b).count;
+  for (const BodyLayout& l : body_layouts(problem)) n += l.count;
   return n;
+}
+
+bool node_selected(const Problem& problem, const NodeSelection& nodes, const Vec3& x) {
+  if (nodes.all) return true;
+  if (nodes.polygon)
+    return geometry::inside_or_on(nodes.polygon->vertices, {x[0], x[1]},
+                                  1e-6 * min_cell_size(problem));
+  for (int a = 0; a < problem.dimension; ++a) {
+    const double tol = 1e-9 * cell_size(problem, a);
+    if (x[a] < nodes.box.min[a] - tol || x[a] > nodes.box.max[a] + tol) return false;
+  }
+  return true;
+}
+
+bool particle_selected(const Problem& problem, const Traction& traction, const Vec3& x) {
+  if (traction.polygon)
+    return geometry::inside_or_on(traction.polygon->vertices, {x[0], x[1]},
+                                  1e-6 * min_cell_size(problem));
+  for (int a = 0; a < problem.dimension; ++a)
+    if (x[a] < traction.particles.min[a] - 1e-12 || x[a] > traction.particles.max[a] + 1e-12)
+      return false;
+  return true;
 }
 
 std::vector<Vec3> initial_positions(const Problem& problem) {
   std::vector<Vec3> out;
-  out.reserve(static_cast<std::size_t>(count_particles(problem)));
-  for (const Body& b : problem.bodies) {
-    const BodyLayout layout = body_layout(problem, b);
-    for (double z : layout.coords[2])
-      for (double y : layout.coords[1])
-        for (double x : layout.coords[0]) out.push_back({x, y, z});
-  }
+  for (const BodyLayout& l : body_layouts(problem))
+    out.insert(out.end(), l.positions.begin(), l.positions.end());
   return out;
 }
 
@@ -77,19 +255,14 @@ std::int64_t nearest_particle(const Problem& problem, const Vec3& x) {
   std::int64_t best = -1;
   double best_d2 = std::numeric_limits<double>::infinity();
   std::int64_t index = 0;
-  for (const Body& b : problem.bodies) {
-    const BodyLayout layout = body_layout(problem, b);
-    for (double pz : layout.coords[2])
-      for (double py : layout.coords[1])
-        for (double px : layout.coords[0]) {
-          const double d2 =
-              (px - x[0]) * (px - x[0]) + (py - x[1]) * (py - x[1]) + (pz - x[2]) * (pz - x[2]);
-          if (d2 < best_d2) {
-            best_d2 = d2;
-            best = index;
-          }
-          ++index;
-        }
+  for (const Vec3& p : initial_positions(problem)) {
+    const double d2 = (p[0] - x[0]) * (p[0] - x[0]) + (p[1] - x[1]) * (p[1] - x[1]) +
+                      (p[2] - x[2]) * (p[2] - x[2]);
+    if (d2 < best_d2) {
+      best_d2 = d2;
+      best = index;
+    }
+    ++index;
   }
   return best;
 }
@@ -113,6 +286,144 @@ namespace {
 
 std::string fmt(double v) {
   return format_significant(v, 4);
+}
+
+}  // namespace
+
+/// A polygon must have 3 or more vertices, no repeated vertex, non-zero
+/// area and no crossing or touching edges.
+void check_polygon(const Polygon& polygon, const Location& w, std::vector<ProblemIssue>& issues) {
+  const std::vector<geometry::Point2>& v = polygon.vertices;
+  const std::size_t n = v.size();
+  if (n < 3) {
+    issues.push_back({w, "has " + std::to_string(n) +
+                             " vertices; a polygon needs at least 3, [[x, y], ...] in order "
+                             "along its boundary (it closes itself)"});
+    return;
+  }
+  for (std::size_t k = 0; k < n; ++k) {
+    const std::size_t next = (k + 1) % n;
+    if (v[k] == v[next]) {
+      const std::size_t later = std::max(k, next), earlier = std::min(k, next);
+      issues.push_back({w / later, "repeats vertex " + std::to_string(earlier) +
+                                       "; list each corner once (the polygon closes itself: do "
+                                       "not repeat the first vertex at the end)"});
+      return;
+    }
+  }
+  const auto [lo, hi] = geometry::bounds(v);
+  const double extent = std::max(hi[0] - lo[0], hi[1] - lo[1]);
+  if (std::abs(geometry::signed_area(v)) <= 1e-12 * extent * extent) {
+    issues.push_back({w,
+                      "has zero area: its vertices lie on one line; give the corners of a "
+                      "region"});
+    return;
+  }
+  if (const auto crossing = geometry::self_intersection(v)) {
+    const auto [i, j] = *crossing;
+    auto edge = [&](std::size_t e) {
+      return "edge " + std::to_string(e) + " (vertex " + std::to_string(e) + " to " +
+             std::to_string((e + 1) % n) + ")";
+    };
+    issues.push_back({w, "is not a simple polygon: " + edge(i) + " and " + edge(j) +
+                             " cross or touch; list the vertices in order along the boundary "
+                             "so that no two edges meet except at their shared vertex"});
+  }
+}
+
+namespace {
+
+/// Whether a 2D point lies in the grid (within 1e-9 of its extent).
+bool in_grid(const Problem& problem, const Vec3& x) {
+  for (int a = 0; a < problem.dimension; ++a) {
+    const double tol = 1e-9 * (problem.grid.max[a] - problem.grid.min[a]);
+    if (!(x[a] >= problem.grid.min[a] - tol && x[a] <= problem.grid.max[a] + tol)) return false;
+  }
+  return true;
+}
+
+std::string grid_range(const Problem& problem) {
+  std::string out;
+  const char* names[] = {"x", "y", "z"};
+  for (int a = 0; a < problem.dimension; ++a)
+    out += std::string(a ? ", " : "") + names[a] + " in [" + fmt(problem.grid.min[a]) + ", " +
+           fmt(problem.grid.max[a]) + "]";
+  return out;
+}
+
+void check_selection_polygon(const Problem& problem, const Polygon& polygon, const Location& w,
+                             std::vector<ProblemIssue>& issues) {
+  if (problem.dimension != 2) {
+    issues.push_back({w,
+                      "selects by a polygon in the (x, y) plane, which needs a 2D problem; "
+                      "this one is " +
+                          std::to_string(problem.dimension) + "D: select by 'box'"});
+    return;
+  }
+  check_polygon(polygon, w, issues);
+}
+
+void check_body_shape(const Problem& problem, const Body& body, const Location& w,
+                      std::vector<ProblemIssue>& issues) {
+  const int shapes = (body.polygon ? 1 : 0) + (body.prism ? 1 : 0) + (body.points ? 1 : 0);
+  if (shapes > 1) {
+    issues.push_back({w,
+                      "gives more than one shape; give exactly one of 'box', 'polygon', "
+                      "'prism' and 'points'"});
+    return;
+  }
+  const int dim = problem.dimension;
+  if (body.polygon) {
+    if (dim != 2)
+      issues.push_back(
+          {w / "polygon", "is a 2D shape but this problem is " + std::to_string(dim) + "D; use " +
+                              (dim == 3 ? "'prism' (a polygon extruded along an axis)" : "'box'") +
+                              " or 'points'"});
+    else
+      check_polygon(*body.polygon, w / "polygon", issues);
+  }
+  if (body.prism) {
+    const Prism& pr = *body.prism;
+    if (dim != 3) {
+      issues.push_back({w / "prism", "is a 3D shape but this problem is " + std::to_string(dim) +
+                                         "D; use " + (dim == 2 ? "'polygon'" : "'box'") +
+                                         " or 'points'"});
+      return;
+    }
+    if (pr.axis < 0 || pr.axis > 2) issues.push_back({w / "prism" / "axis", "must be x, y or z"});
+    if (!(pr.to > pr.from))
+      issues.push_back({w / "prism" / "to",
+                        "is " + fmt(pr.to) + "; must be greater than from (" + fmt(pr.from) + ")"});
+    check_polygon(pr.polygon, w / "prism" / "polygon", issues);
+  }
+  if (body.points) {
+    const ParticleList& pl = *body.points;
+    const Location wp = w / "points";
+    if (pl.positions.empty())
+      issues.push_back({wp / "positions",
+                        "is empty; give at least one "
+                        "particle"});
+    if (pl.volumes.size() != pl.positions.size())
+      issues.push_back({wp / "volumes", "has " + std::to_string(pl.volumes.size()) +
+                                            " entries but positions has " +
+                                            std::to_string(pl.positions.size()) +
+                                            "; give one volume per position"});
+    int reported = 0;  // the first few of a long list say enough
+    for (std::size_t k = 0; k < pl.volumes.size() && reported < 10; ++k)
+      if (!(pl.volumes[k] > 0 && std::isfinite(pl.volumes[k]))) {
+        issues.push_back({wp / "volumes" / k, "is " + fmt(pl.volumes[k]) +
+                                                  "; a particle volume must be > 0 (m^3 in 3D, "
+                                                  "m^2 per metre in 2D, m in 1D)"});
+        ++reported;
+      }
+    reported = 0;
+    for (std::size_t k = 0; k < pl.positions.size() && reported < 10; ++k)
+      if (!in_grid(problem, pl.positions[k])) {
+        issues.push_back({wp / "positions" / k, "lies outside the grid (" + grid_range(problem) +
+                                                    "); particles must start inside it"});
+        ++reported;
+      }
+  }
 }
 
 }  // namespace
@@ -142,6 +453,17 @@ std::vector<ProblemIssue> problem_warnings(const Problem& problem) {
                   "false (drops the term)";
     warnings.push_back({Location{"materials", m.name, "hydraulic"}, what});
   }
+  const std::vector<BodyLayout> layouts = body_layouts(problem);
+  for (std::size_t b = 0; b < layouts.size(); ++b)
+    for (const auto& [earlier, n] : layouts[b].lost)
+      warnings.push_back(
+          {Location{"bodies"} / b,
+           "overlaps body " + std::to_string(earlier) + ": " + std::to_string(n) +
+               " of its particle positions lie inside body " + std::to_string(earlier) +
+               ", which is listed first, so they belong to body " + std::to_string(earlier) +
+               " (a place inside several bodies gets one particle, of the first). What to "
+               "change: nothing if intended; else shrink body " +
+               std::to_string(b) + " or list it first"});
   return warnings;
 }
 
@@ -182,17 +504,42 @@ std::vector<ProblemIssue> check_problem(const Problem& problem) {
     }
   }
   if (problem.bodies.empty()) add({"bodies"}, "at least one body is needed");
+  const std::size_t before_shapes = issues.size();
+  for (std::size_t b = 0; b < problem.bodies.size(); ++b)
+    check_body_shape(problem, problem.bodies[b], Location{"bodies"} / b, issues);
+  for (std::size_t i = 0; i < problem.boundaries.size(); ++i)
+    if (problem.boundaries[i].nodes.polygon && !problem.boundaries[i].nodes.all)
+      check_selection_polygon(problem, *problem.boundaries[i].nodes.polygon,
+                              Location{"boundaries"} / i / "nodes" / "polygon", issues);
+  for (std::size_t i = 0; i < problem.tractions.size(); ++i)
+    if (problem.tractions[i].polygon)
+      check_selection_polygon(problem, *problem.tractions[i].polygon,
+                              Location{"tractions"} / i / "particles" / "polygon", issues);
+  if (issues.size() > before_shapes) return issues;
+  const std::vector<BodyLayout> layouts = body_layouts(problem);
   for (std::size_t b = 0; b < problem.bodies.size(); ++b) {
     const Body& body = problem.bodies[b];
     const Location w = Location{"bodies"} / b;
     if (body.material < 0 || body.material >= static_cast<int>(problem.materials.size()))
       add(w / "material", "names no material");
-    if (body.particles_per_cell < 1)
+    if (body.particles_per_cell < 1) {
       add(w / "particles_per_cell", "must be >= 1");
-    else if (body_layout(problem, body).count == 0)
+    } else if (layouts[b].count == 0 && !layouts[b].lost.empty()) {
+      add(w,
+          "has no particles: every particle position of it lies inside an earlier body, "
+          "which owns it (a place inside several bodies gets one particle, of the first); "
+          "remove the body or list it first");
+    } else if (layouts[b].count == 0 && body.points) {
+      add(w / "points" / "positions", "is empty; give at least one particle");
+    } else if (layouts[b].count == 0 && (body.polygon || body.prism)) {
+      add(w / (body.polygon ? "polygon" : "prism"),
+          "contains no sub-cell centre, so no particles (particles lie at sub-cell centres, "
+          "cell size / particles_per_cell apart); enlarge the shape or refine the grid");
+    } else if (layouts[b].count == 0) {
       add(w / "box",
           "contains no whole grid cell, so no particles; a body fills the cells "
           "that lie entirely inside its box");
+    }
   }
   for (std::size_t i = 0; i < problem.boundaries.size(); ++i) {
     const Boundary& bc = problem.boundaries[i];

@@ -20,13 +20,17 @@
 namespace hmpm {
 
 template <int Dim, class Shape>
-Simulation<Dim, Shape>::Simulation(const Problem& problem) : problem_(problem) {
+Simulation<Dim, Shape>::Simulation(const Problem& problem, const RunOptions& options)
+    : problem_(problem), interrupt_(options.cancel, options.wall_time_limit_s) {
   setup_grid();
   setup_materials();
   setup_particles();
+  interrupt_.stage("compiling boundaries and tractions");
+  interrupt_.check();
   constraints_ = compile_constraints<Dim>(problem_, grid_, grid_max_, fluid_);
   tractions_ = compile_tractions<Dim>(problem_, particles_, grid_);
   setup_geostatic();
+  interrupt_.check();
 }
 
 template <int Dim, class Shape>
@@ -67,40 +71,47 @@ void Simulation<Dim, Shape>::setup_materials() {
 template <int Dim, class Shape>
 void Simulation<Dim, Shape>::setup_particles() {
   const bool gimp = std::is_same_v<Shape, shape::Gimp>;
-  particles_.resize(static_cast<std::size_t>(count_particles(problem_)), fluid_, gimp,
-                    state_variables_);
+  interrupt_.stage("generating particles and evaluating their initial fields");
+  const std::vector<BodyLayout> layouts = body_layouts(problem_);
+  std::int64_t count = 0;
+  for (const BodyLayout& l : layouts) count += l.count;
+  particles_.resize(static_cast<std::size_t>(count), fluid_, gimp, state_variables_);
   grid_.resize(fluid_);
   std::size_t p = 0;
   double cell_volume = 1.0;
   for (int a = 0; a < Dim; ++a) cell_volume *= grid_.h[a];
-  for (const Body& body : problem_.bodies) {
-    const BodyLayout layout = body_layout(problem_, body);
+  for (std::size_t b = 0; b < problem_.bodies.size(); ++b) {
+    const Body& body = problem_.bodies[b];
+    const BodyLayout& layout = layouts[b];
     const MaterialConstants& mc = constants_[static_cast<std::size_t>(body.material)];
     const int ppc = body.particles_per_cell;
-    const double v0 = cell_volume / std::pow(ppc, Dim);
-    for (double z : layout.coords[2])
-      for (double y : layout.coords[1])
-        for (double x : layout.coords[0]) {
-          const Vec3 x3{x, y, z};
-          for (int a = 0; a < Dim; ++a) particles_.x[p][a] = x3[a];
-          particles_.x0[p] = particles_.x[p];
-          particles_.volume[p] = v0;
-          particles_.mass[p] = mc.mixture_density * v0;
-          particles_.material[p] = static_cast<std::uint16_t>(body.material);
-          if (gimp) particles_.half_length[p] = 0.5 / ppc;
-          const InitialFields& init = body.initial;
-          for (int a = 0; a < Dim; ++a)
-            if (init.velocity[a]) particles_.v[p][a] = init.velocity[a](x3);
-          for (int c = 0; c < 6; ++c)
-            if (init.effective_stress[c]) particles_.stress[p][c] = init.effective_stress[c](x3);
-          if (fluid_ && mc.saturated) {
-            const double p0 = init.pore_pressure ? init.pore_pressure(x3) : 0.0;
-            particles_.pressure[p] = p0;
-            particles_.pressure_out[p] = p0;
-            particles_.porosity[p] = mc.porosity;
-          }
-          ++p;
-        }
+    for (std::size_t k = 0; k < layout.positions.size(); ++k) {
+      interrupt_.poll(p);
+      const Vec3& x3 = layout.positions[k];
+      const double v0 = layout.volumes[k];
+      for (int a = 0; a < Dim; ++a) particles_.x[p][a] = x3[a];
+      particles_.x0[p] = particles_.x[p];
+      particles_.volume[p] = v0;
+      particles_.mass[p] = mc.mixture_density * v0;
+      particles_.material[p] = static_cast<std::uint16_t>(body.material);
+      // GIMP half-length in cell units: of the sub-cell, or of the cube
+      // of a points body's particle volume.
+      if (gimp)
+        particles_.half_length[p] =
+            body.points ? 0.5 * std::pow(v0 / cell_volume, 1.0 / Dim) : 0.5 / ppc;
+      const InitialFields& init = body.initial;
+      for (int a = 0; a < Dim; ++a)
+        if (init.velocity[a]) particles_.v[p][a] = init.velocity[a](x3);
+      for (int c = 0; c < 6; ++c)
+        if (init.effective_stress[c]) particles_.stress[p][c] = init.effective_stress[c](x3);
+      if (fluid_ && mc.saturated) {
+        const double p0 = init.pore_pressure ? init.pore_pressure(x3) : 0.0;
+        particles_.pressure[p] = p0;
+        particles_.pressure_out[p] = p0;
+        particles_.porosity[p] = mc.porosity;
+      }
+      ++p;
+    }
   }
 }
 
@@ -116,7 +127,8 @@ void Simulation<Dim, Shape>::setup_particles() {
 template <int Dim, class Shape>
 void Simulation<Dim, Shape>::setup_geostatic() {
   if (!problem_.initial_state.geostatic) return;
-  const GeostaticState g = geostatic_state(problem_);
+  interrupt_.stage("computing the geostatic state");
+  const GeostaticState g = geostatic_state(problem_, &interrupt_);
   for (std::size_t p = 0; p < particles_.size(); ++p) {
     geostatic_voigt(g, p, particles_.stress[p].data());
     if (fluid_ && constants_[particles_.material[p]].saturated) {
@@ -140,10 +152,13 @@ void Simulation<Dim, Shape>::balance_initial_pressure_state() {
   if (scale == 0.0) return;
   StencilT s;
   double checkpoint = std::numeric_limits<double>::infinity();
+  interrupt_.stage("balancing the initial pore pressure");
   for (int iteration = 0; iteration < 500; ++iteration) {
+    interrupt_.check();
     std::fill(grid_.storage.begin(), grid_.storage.end(), 0.0);
     std::fill(grid_.pressure.begin(), grid_.pressure.end(), 0.0);
     for (std::size_t p = 0; p < particles_.size(); ++p) {
+      interrupt_.poll(p);
       const std::uint16_t mat = particles_.material[p];
       if (!constants_[mat].saturated) continue;
       stencil_of<false>(p, s);

@@ -44,6 +44,7 @@
 #include "boundary/tractions.hpp"
 #include "hmpm/problem.hpp"
 #include "hmpm/run.hpp"
+#include "interrupt.hpp"
 #include "materials/material.hpp"
 #include "parallel.hpp"
 #include "shape.hpp"
@@ -67,7 +68,9 @@ class Simulation {
   using StencilT = shape::Stencil<Dim, Shape>;
   using Out = Scatter<Dim>;
 
-  explicit Simulation(const Problem& problem);
+  /// Sets the run up; honours options.cancel and options.wall_time_limit_s
+  /// while doing so (throws SetupInterrupted, see interrupt.hpp).
+  Simulation(const Problem& problem, const RunOptions& options);
 
   /// Runs the time loop to problem.time.end (time_loop.hpp).
   RunResult run(const RunOptions& options);
@@ -218,6 +221,9 @@ class Simulation {
   void fail_nonfinite(std::size_t p, const char* what);
   void fail_left_grid(std::size_t p);
   void fail_volume(std::size_t p, double j);
+  /// False (and a failure of the run naming the formula's place in the
+  /// spec) when a traction or boundary value is not finite at time t.
+  bool loads_finite_at(double t);
   static std::string number(double v);
 
   // ------------------------------------------------------------ output (output.hpp)
@@ -225,6 +231,7 @@ class Simulation {
   void sample_series(Series& series, double t) const;
 
   const Problem& problem_;
+  SetupInterrupt interrupt_;  ///< set-up's stop checks; its start is the run's start
   GridState<Dim> grid_;
   ParticleState<Dim> particles_;
   std::vector<MaterialConstants> constants_;

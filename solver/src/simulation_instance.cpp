@@ -16,19 +16,39 @@ template class Simulation<HMPM_DIM, shape::Linear>;
 template class Simulation<HMPM_DIM, shape::Gimp>;
 template class Simulation<HMPM_DIM, shape::BSpline>;
 
+namespace {
+
+/// Sets up and runs; a set-up stopped by cancellation or the wall-time
+/// limit (interrupt.hpp) ends the run as cancelled or failed.
+template <class Shape>
+RunResult run_checked(const Problem& problem, const RunOptions& options) {
+  try {
+    Simulation<HMPM_DIM, Shape> simulation(problem, options);
+    return simulation.run(options);
+  } catch (const SetupInterrupted& stop) {
+    RunResult result;
+    result.status = stop.status;
+    result.message = stop.message;
+    result.scheme = scheme_name(problem.time.scheme);
+    return result;
+  }
+}
+
+}  // namespace
+
 template <>
 RunResult run_simulation<HMPM_DIM, shape::Linear>(const Problem& problem,
                                                   const RunOptions& options) {
-  return Simulation<HMPM_DIM, shape::Linear>(problem).run(options);
+  return run_checked<shape::Linear>(problem, options);
 }
 template <>
 RunResult run_simulation<HMPM_DIM, shape::Gimp>(const Problem& problem, const RunOptions& options) {
-  return Simulation<HMPM_DIM, shape::Gimp>(problem).run(options);
+  return run_checked<shape::Gimp>(problem, options);
 }
 template <>
 RunResult run_simulation<HMPM_DIM, shape::BSpline>(const Problem& problem,
                                                    const RunOptions& options) {
-  return Simulation<HMPM_DIM, shape::BSpline>(problem).run(options);
+  return run_checked<shape::BSpline>(problem, options);
 }
 
 }  // namespace hmpm

@@ -1,6 +1,7 @@
 // time_loop.hpp — the time loop around a time scheme's step: time-step
-// control, output sampling, progress, cancellation, the wall-time limit and
-// failure reports (internal). The scheme (schemes/) owns the step and its
+// control, output sampling, progress, cancellation, the wall-time limit,
+// checkpoints and resuming from one (checkpoint.hpp), and failure reports
+// (internal). The scheme (schemes/) owns the step and its
 // stable-step rule; this loop owns everything between steps.
 #pragma once
 
@@ -11,9 +12,12 @@
 #include <limits>
 #include <memory>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 #include <thread>
+#include <vector>
 
+#include "checkpoint.hpp"
 #include "output.hpp"
 #include "schemes/explicit_scheme.hpp"
 #include "schemes/quasi_static_scheme.hpp"
@@ -87,26 +91,96 @@ RunResult Simulation<Dim, Shape>::run(const RunOptions& options) {
       for (int a = 0; a < Dim; ++a) x0[a] = particles_.x[static_cast<std::size_t>(pi)][a];
       series.initial_positions.push_back(x0);
     }
-    sample_series(series, 0.0);
   }
   std::vector<Field> snapshot_fields = out.snapshot_fields;
   if (snapshot_fields.empty())
     for (int f = 0; f < field_count; ++f) snapshot_fields.push_back(static_cast<Field>(f));
   const bool want_snapshots = out.snapshot_interval > 0 && options.on_snapshot;
   Snapshot snap;
+  std::vector<double> snapshot_times;  // of the snapshots taken, for checkpoints
   auto take_snapshot = [&](double t) {
     snap.time = t;
     fill_snapshot(snap, snapshot_fields);
     options.on_snapshot(snap);
     ++snap.index;
+    snapshot_times.push_back(t);
   };
-  if (want_snapshots) take_snapshot(0.0);
   double next_series = out.series_interval > 0 ? out.series_interval : 0.0;
   double next_snapshot = out.snapshot_interval;
   const double eps_t = 1e-9 * dt;
+  std::int64_t n = 0;
+  double t = 0.0;
+  double seconds_before = 0.0;  // loop wall time of the runs before a resume
+  if (options.resume) {
+    // Everything the loop carries, as the checkpoint left it after step n
+    // (the initial positions of the series come from the set-up above).
+    checkpoint::Reader r(*options.resume, checkpoint::body_end(*options.resume));
+    const checkpoint::Header h =
+        checkpoint::read_header(r, *options.resume, problem_, options.checkpoint_key);
+    n = h.step;
+    t = h.time;
+    total = h.total;
+    next_series = h.next_series;
+    next_snapshot = h.next_snapshot;
+    seconds_before = h.seconds;
+    snapshot_times = h.snapshot_times;
+    snap.index = static_cast<int>(snapshot_times.size());
+    r.array(series.time, -1, "series times");
+    const auto fields = r.pod<std::uint64_t>();
+    if (fields != series.values.size())
+      throw std::invalid_argument("the checkpoint's series has " + std::to_string(fields) +
+                                  " fields where this run has " +
+                                  std::to_string(series.values.size()));
+    for (std::vector<double>& v : series.values) r.array(v, -1, "series values");
+    particles_.for_each_array(
+        [&](auto& a) { r.array(a, static_cast<std::int64_t>(a.size()), "particle array"); });
+    time_scheme.load(r);
+    if (r.position() != checkpoint::body_end(*options.resume))
+      throw std::invalid_argument(
+          "the checkpoint has " +
+          std::to_string(checkpoint::body_end(*options.resume) - r.position()) +
+          " bytes more than this run's state");
+  } else {
+    if (want_series) sample_series(series, 0.0);
+    if (want_snapshots) take_snapshot(0.0);
+  }
 
   const auto start = Clock::now();
   auto last_progress = start;
+  auto last_checkpoint = start;
+  const bool want_checkpoints = options.on_checkpoint && options.checkpoint_interval_s > 0;
+  Checkpoint ckpt;
+  std::int64_t checkpointed = n;  // steps done at the last checkpoint (or the resume)
+  // The state after `done` steps (t the time reached).
+  auto write_checkpoint = [&](std::int64_t done, Clock::time_point now) {
+    checkpointed = done;
+    ckpt.step = done;
+    ckpt.time = t;
+    ckpt.bytes.clear();
+    checkpoint::Writer w(ckpt.bytes);
+    checkpoint::Header h;
+    h.dimension = Dim;
+    h.shape = static_cast<std::uint32_t>(problem_.shape_function);
+    h.scheme = static_cast<std::uint32_t>(problem_.time.scheme);
+    h.particles = static_cast<std::int64_t>(particles_.size());
+    h.fingerprint = checkpoint::fingerprint(problem_, options.checkpoint_key);
+    h.threads = threads;
+    h.step = done;
+    h.time = t;
+    h.total = total;
+    h.next_series = next_series;
+    h.next_snapshot = next_snapshot;
+    h.seconds = seconds_before + std::chrono::duration<double>(now - start).count();
+    h.snapshot_times = snapshot_times;
+    checkpoint::write_header(w, h);
+    w.array(series.time);
+    w.pod(static_cast<std::uint64_t>(series.values.size()));
+    for (const std::vector<double>& v : series.values) w.array(v);
+    particles_.for_each_array([&](const auto& a) { w.array(a); });
+    time_scheme.save(w);
+    checkpoint::finish(w);
+    options.on_checkpoint(ckpt);
+  };
   auto report = [&](std::int64_t n, double t) {
     if (!options.on_progress) return;
     Progress pr;
@@ -119,10 +193,11 @@ RunResult Simulation<Dim, Shape>::run(const RunOptions& options) {
   };
 
   result.status = RunStatus::successful;
-  std::int64_t n = 0;
-  double t = 0.0;
   for (; fixed ? n < total : t < end; ++n) {
     if (options.cancel && options.cancel->load(std::memory_order_relaxed)) {
+      // A last checkpoint, so that a run stopped on purpose (a server
+      // shutting down) resumes where it stopped.
+      if (want_checkpoints && n > checkpointed) write_checkpoint(n, Clock::now());
       result.status = RunStatus::cancelled;
       result.message = "cancelled at step " + std::to_string(n) + " (t = " + number(t) + " s)";
       break;
@@ -137,7 +212,11 @@ RunResult Simulation<Dim, Shape>::run(const RunOptions& options) {
       t_new = t + h >= end - 0.01 * h ? end : t + h;
       if (n + 1 >= total) total = n + 2;
     }
-    time_scheme.step(t, t_new - t);
+    // Load and boundary formulas are checked at the step's end time before
+    // the step uses them (the start's was checked by the step before, or
+    // below for t = 0): a NaN there is reported as the formula's, not as the
+    // divergence it would cause.
+    if ((n > 0 || loads_finite_at(t)) && loads_finite_at(t_new)) time_scheme.step(t, t_new - t);
     if (failed_) {
       std::ostringstream where;
       if (failure_particle_ >= 0) {  // -1: a failure of the run, not of a particle
@@ -168,7 +247,8 @@ RunResult Simulation<Dim, Shape>::run(const RunOptions& options) {
       last_progress = now;
       report(n + 1, t);
       if (options.wall_time_limit_s > 0 &&
-          std::chrono::duration<double>(now - start).count() > options.wall_time_limit_s) {
+          seconds_before + std::chrono::duration<double>(now - interrupt_.start()).count() >
+              options.wall_time_limit_s) {  // set-up counts too
         result.status = RunStatus::failed;
         result.message = "wall-time limit of " + number(options.wall_time_limit_s) +
                          " s reached at step " + std::to_string(n + 1) + " of " +
@@ -179,8 +259,14 @@ RunResult Simulation<Dim, Shape>::run(const RunOptions& options) {
         break;
       }
     }
+    if (want_checkpoints && std::chrono::duration<double>(now - last_checkpoint).count() >=
+                                options.checkpoint_interval_s) {
+      write_checkpoint(n + 1, now);
+      last_checkpoint = Clock::now();  // the interval runs from the end of the write
+    }
   }
-  const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  const double seconds =
+      seconds_before + std::chrono::duration<double>(Clock::now() - start).count();
   time_scheme.report(result);
   result.steps = n;
   result.end_time = t;

@@ -120,6 +120,61 @@ TEST(ParseJob, RoundTripOfEveryField) {
   EXPECT_GT(c.output_bytes, 0);
 }
 
+// Issue 22 item 7: the memory estimate counts a private copy of the
+// grid's nodal sums per extra solver thread, and the series kept in memory.
+TEST(CostEstimate, MemoryCountsThreadBuffersAndTheSeries) {
+  const ParsedJob job = parse_valid(R"json({"dimension": 2,
+      "grid": {"min": [0, 0], "max": [1, 1], "cells": [400, 400]},
+      "materials": {"m": {"model": "linear_elastic", "density": 2000, "youngs_modulus": 1e7,
+                          "poisson_ratio": 0.3}},
+      "bodies": [{"material": "m", "box": {"min": [0, 0], "max": [1, 1]},
+                  "particles_per_cell": 1}],
+      "time": {"end": 1e-6, "dt": 1e-7}})json");
+  Calibration one, eight;
+  eight.threads = 8;
+  const CostEstimate c1 = estimate_cost(job.problem, one);
+  const CostEstimate c8 = estimate_cost(job.problem, eight);
+  EXPECT_EQ(c1.threads, 1);
+  EXPECT_EQ(c8.threads, 8);  // 160 000 particles: 20 000 per thread
+  // Mass, momentum, force and remap per node: 8 * (1 + 3 * 2) bytes.
+  EXPECT_EQ(c8.memory_bytes - c1.memory_bytes, 7 * c1.nodes * 8 * 7);
+
+  ParsedJob series = job;
+  series.problem.output.series_particles.assign(1000, 0);
+  series.problem.output.series_fields = {Field::effective_stress};
+  const CostEstimate cs = estimate_cost(series.problem, one);
+  EXPECT_EQ(cs.series_rows, 11);
+  // 11 rows of 1 + 1000 * 6 values, with room for the vectors' growth.
+  EXPECT_GE(cs.memory_bytes - c1.memory_bytes, 11 * 6001 * 8);
+}
+
+// Issue 22 item 5: the formulas of a spec are bounded in count and length.
+TEST(ParseJob, FormulaBudgetIsEnforced) {
+  std::string f = "x";
+  while (f.size() < 4000) f += "+x";
+  std::string bodies;
+  for (int b = 0; b < 20; ++b)
+    bodies += std::string(b ? "," : "") +
+              R"({"material": "m", "box": {"min": [0], "max": [1]}, "initial": {"velocity": [")" +
+              f + R"("]}})";
+  const std::string spec = R"({"dimension": 1, "grid": {"min": [0], "max": [1], "cells": [10]},
+      "materials": {"m": {"model": "linear_elastic", "density": 2000, "youngs_modulus": 1e7,
+                          "poisson_ratio": 0.3}},
+      "bodies": [)" + bodies +
+                           R"(], "time": {"end": 1e-3}})";
+  const ParseResult r = parse_job(spec);
+  ASSERT_FALSE(r.ok());
+  ASSERT_EQ(r.errors.size(), 1u);  // reported once, at the formula that crosses it
+  EXPECT_EQ(r.errors[0].path, "/bodies/16/initial/velocity/0");
+  EXPECT_NE(r.errors[0].message.find("max_formula_characters"), std::string::npos);
+  Limits few;
+  few.max_formulas = 3;
+  const ParseResult r3 = parse_job(spec, few);
+  ASSERT_EQ(r3.errors.size(), 1u);
+  EXPECT_EQ(r3.errors[0].path, "/bodies/3/initial/velocity/0");
+  EXPECT_NE(r3.errors[0].message.find("max_formulas"), std::string::npos);
+}
+
 TEST(ParseJob, DefaultsOfTheContract) {
   const ParsedJob job =
       parse_valid(R"json({"dimension": 1, "grid": {"min": [0], "max": [1], "cells": [10]},

@@ -2,8 +2,10 @@
 // series.json layout of the contract, series.csv header and rows, VTU and PVD
 // read back by an independent reader (meshio, via check_results.py), atomic
 // writes, and run_job's summary on success and on failure.
+#include <atomic>
 #include <cmath>
 #include <filesystem>
+#include <string>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -209,17 +211,74 @@ TEST(RunJob, WritesEveryRequestedFileAndASummary) {
   EXPECT_NE(std::find(out.files.begin(), out.files.end(), "snapshots.pvd"), out.files.end());
 }
 
-TEST(RunJob, FailedWriteStillLeavesASummaryAndThrows) {
+TEST(RunJob, FailedWriteLeavesOnlyASummaryAndSaysWhy) {
   const ParseResult parsed =
       parse_job(testing::read_text(testing::source_path("examples/bar-vibration.json")));
   ASSERT_TRUE(parsed.job);
   testing::TempDir dir;
-  // A directory where the first snapshot file should go makes its rename fail.
-  fs::create_directories(dir.path() / "snapshot_0000.vtu" / "blocker");
-  EXPECT_THROW(run_job(*parsed.job, dir.path()), std::runtime_error);
+  // A directory where the second snapshot file should go makes its rename
+  // fail after the first snapshot and the .pvd were written.
+  fs::create_directories(dir.path() / "snapshot_0001.vtu" / "blocker");
+  const JobOutcome out = run_job(*parsed.job, dir.path());
+  EXPECT_NE(out.write_error.find("snapshot_0001"), std::string::npos) << out.write_error;
+  EXPECT_EQ(out.run.status, RunStatus::failed);
+  EXPECT_EQ(out.files, std::vector<std::string>{"summary.json"});
+  // The snapshot and collection written before the failure are gone.
+  EXPECT_FALSE(fs::exists(dir.path() / "snapshot_0000.vtu"));
+  EXPECT_FALSE(fs::exists(dir.path() / "snapshots.pvd"));
   const json summary = json::parse(testing::read_text(dir.path() / "summary.json"));
   EXPECT_EQ(summary["status"], "failed");
   EXPECT_NE(summary["message"].get<std::string>().find("could not write"), std::string::npos);
+  EXPECT_NE(summary["message"].get<std::string>().find("removed"), std::string::npos);
+}
+
+// A run stopped after a checkpoint and resumed from it in the same folder
+// writes the files of an uninterrupted run: the snapshots before the
+// checkpoint stay (and are listed in the .pvd again), the series comes from
+// the checkpoint; summary.json differs in its wall-time fields only.
+TEST(RunJob, ResumedFromACheckpointWritesTheFilesOfAnUninterruptedRun) {
+  const ParseResult parsed =
+      parse_job(testing::read_text(testing::source_path("examples/bar-vibration.json")));
+  ASSERT_TRUE(parsed.job);
+  testing::TempDir dir;
+  const JobOutcome whole = run_job(*parsed.job, dir.path() / "whole");
+  ASSERT_EQ(whole.run.status, RunStatus::successful) << whole.run.message;
+  const std::int64_t k = whole.run.steps / 2;
+  std::string bytes;
+  std::atomic<bool> stop{false};
+  RunOptions first;
+  first.checkpoint_interval_s = 1e-12;  // every step
+  first.checkpoint_key = "bar";
+  first.cancel = &stop;
+  first.on_checkpoint = [&](const Checkpoint& c) {
+    if (c.step == k) {
+      bytes = c.bytes;
+      stop = true;
+    }
+  };
+  const JobOutcome stopped = run_job(*parsed.job, dir.path() / "resumed", first);
+  ASSERT_EQ(stopped.run.status, RunStatus::cancelled);
+  ASSERT_FALSE(bytes.empty());
+  RunOptions again;
+  again.checkpoint_key = "bar";
+  again.resume = &bytes;
+  const JobOutcome resumed = run_job(*parsed.job, dir.path() / "resumed", again);
+  ASSERT_EQ(resumed.run.status, RunStatus::successful) << resumed.run.message;
+  EXPECT_EQ(resumed.files, whole.files);
+  for (const std::string& f : whole.files) {
+    std::string a = testing::read_text(dir.path() / "whole" / f);
+    std::string b = testing::read_text(dir.path() / "resumed" / f);
+    if (f == "summary.json") {
+      json ja = json::parse(a), jb = json::parse(b);
+      for (const char* wall : {"solve_seconds", "particle_steps_per_second"}) {
+        ja.erase(wall);
+        jb.erase(wall);
+      }
+      EXPECT_EQ(ja, jb);
+    } else {
+      EXPECT_EQ(a, b) << f;
+    }
+  }
 }
 
 }  // namespace

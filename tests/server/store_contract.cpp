@@ -13,12 +13,16 @@
 namespace hmpm::server::testing {
 
 void StoreContract::SetUp() {
+  if (GetParam().unavailable) {
+    if (const std::string reason = GetParam().unavailable(); !reason.empty())
+      GTEST_SKIP() << reason;
+  }
   scratch_ = make_temp_dir("store-" + GetParam().name);
 }
 
 void StoreContract::TearDown() {
   store_.reset();
-  std::filesystem::remove_all(scratch_);
+  if (!scratch_.empty()) std::filesystem::remove_all(scratch_);
 }
 
 JobStore& StoreContract::store() {
@@ -212,7 +216,7 @@ TEST_P(StoreContract, QueueCapCountsOnlyWaitingJobs) {
 TEST_P(StoreContract, RecoveryDoesNotRequeueAJobWhoseLeaseIsLive) {
   const auto id = store().submit(job("owned"), 10).job.id;
   const auto claimed = store().claim_next(live());
-  const auto report = store().recover(3);
+  const auto report = store().recover(3, 0.0);
   EXPECT_TRUE(report.requeued.empty());
   EXPECT_TRUE(report.failed.empty());
   const auto job = store().find(id);
@@ -227,7 +231,7 @@ TEST_P(StoreContract, RenewedLeasesStayLiveAndOnlyTheOwnersAreRenewed) {
   store().claim_next(dead("me"));
   store().claim_next(dead("them"));
   EXPECT_EQ(store().renew_leases(Claimant{"me", 600.0}), 1);
-  const auto report = store().recover(3);
+  const auto report = store().recover(3, 0.0);
   ASSERT_EQ(report.requeued.size(), 1u);
   EXPECT_EQ(report.requeued[0], theirs);
   EXPECT_EQ(store().find(mine)->status, JobStatus::running);
@@ -237,7 +241,7 @@ TEST_P(StoreContract, RenewedLeasesStayLiveAndOnlyTheOwnersAreRenewed) {
 TEST_P(StoreContract, ATakenOverJobRefusesTheWritesOfItsEarlierClaim) {
   const auto id = store().submit(job("taken-over"), 10).job.id;
   const Claim stale = claim_of(*store().claim_next(dead("paused")));
-  ASSERT_EQ(store().recover(3).requeued.size(), 1u);
+  ASSERT_EQ(store().recover(3, 0.0).requeued.size(), 1u);
   const Claim current = claim_of(*store().claim_next(live()));
   EXPECT_GT(current.token, stale.token);
   EXPECT_EQ(store().update_progress(stale, 99), ClaimState::lost);
@@ -250,11 +254,54 @@ TEST_P(StoreContract, ATakenOverJobRefusesTheWritesOfItsEarlierClaim) {
             ClaimState::held);
 }
 
+// The attempt limit counts only crashes that can be the job's: an attempt
+// that had run at least charge_after_s (claim to its last renewal or
+// progress write) is charged; one claimed just before an unrelated crash is
+// not, however often that happens, until the backstop of
+// uncharged_start_factor * max_attempts starts.
+TEST_P(StoreContract, RecoveryChargesACrashOnlyToAnAttemptThatRanLongEnough) {
+  const std::string innocent = store().submit(job("innocent"), 10).job.id;
+  const int backstop = uncharged_start_factor * 3;
+  for (int start = 1; start < backstop; ++start) {
+    const auto claimed = store().claim_next(dead());
+    ASSERT_TRUE(claimed);
+    ASSERT_EQ(claimed->id, innocent);
+    advance(std::chrono::seconds(5));
+    EXPECT_EQ(store().update_progress(claim_of(*claimed), 1), ClaimState::held);  // alive at 5 s
+    advance(std::chrono::seconds(60));  // ... and dies there, 5 s into the attempt
+    const auto report = store().recover(3, 30.0);
+    ASSERT_EQ(report.requeued.size(), 1u) << "start " << start;
+  }
+  // The backstop: started backstop times, each crash within 30 s.
+  ASSERT_TRUE(store().claim_next(dead()));
+  advance(std::chrono::seconds(60));
+  const auto stopped = store().recover(3, 30.0);
+  ASSERT_EQ(stopped.failed.size(), 1u);
+  EXPECT_NE(store().find(innocent)->failure_reason.find(std::to_string(backstop) + " times"),
+            std::string::npos)
+      << store().find(innocent)->failure_reason;
+
+  // A job whose attempts ran 40 s before each crash is charged every time.
+  const std::string suspect = store().submit(job("suspect"), 10).job.id;
+  for (int crash = 1; crash <= 3; ++crash) {
+    const auto claimed = store().claim_next(dead());
+    ASSERT_TRUE(claimed);
+    ASSERT_EQ(claimed->id, suspect);
+    advance(std::chrono::seconds(40));
+    store().update_progress(claim_of(*claimed), 50);
+    advance(std::chrono::seconds(60));
+    const auto report = store().recover(3, 30.0);
+    EXPECT_EQ(report.failed.size(), crash == 3 ? 1u : 0u) << "crash " << crash;
+  }
+  EXPECT_EQ(store().find(suspect)->status, JobStatus::failed);
+  EXPECT_NE(store().find(suspect)->failure_reason.find("3 times"), std::string::npos);
+}
+
 TEST_P(StoreContract, RecoveryRequeuesLapsedJobsUntilTheAttemptLimit) {
   const std::string id = store().submit(job("crashy"), 10).job.id;
   store().submit(job("waiting"), 10);
   for (int attempt = 1; attempt <= 3; ++attempt) {
-    const auto report = store().recover(3);  // a new process starts
+    const auto report = store().recover(3, 0.0);  // a new process starts
     if (attempt > 1) {
       ASSERT_EQ(report.requeued.size(), 1u);
       EXPECT_EQ(report.requeued[0], id);
@@ -265,7 +312,7 @@ TEST_P(StoreContract, RecoveryRequeuesLapsedJobsUntilTheAttemptLimit) {
     EXPECT_EQ(claimed->attempts, attempt);
     // ... and the process dies here, leaving the job running with its lease lapsing.
   }
-  const auto report = store().recover(3);
+  const auto report = store().recover(3, 0.0);
   EXPECT_TRUE(report.requeued.empty());
   ASSERT_EQ(report.failed.size(), 1u);
   const auto failed = store().find(id);
@@ -390,6 +437,85 @@ TEST_P(StoreContract, PurgeForgetsOnlyJobsThatEndedBeforeTheCutoff) {
   EXPECT_EQ(store().list({}, "", 100).size(), 3u);
   // A purged job's idempotency key is free again: the same key makes a new job.
   EXPECT_EQ(store().submit(job("again", "done-key", "h2"), 100).outcome, SubmitOutcome::created);
+}
+
+CheckpointRecord checkpoint_at(std::int64_t step, const Claim& claim) {
+  return CheckpointRecord{"checkpoint-" + std::to_string(claim.token) + "-" + std::to_string(step),
+                          step,
+                          0.5 * static_cast<double>(step),
+                          1000 + step,
+                          std::string(64, 'c'),
+                          "2026-12-02T12:00:00.000Z"};
+}
+
+// Checkpoints: written under the claim like progress, replaced by the next
+// one, kept while the job waits to be resumed (requeue, recovery after a
+// crash, the next claim), forgotten when the job ends.
+TEST_P(StoreContract, CheckpointsAreFencedKeptForTheNextAttemptAndClearedAtTheEnd) {
+  const auto id = store().submit(job("checkpointed"), 10).job.id;
+  EXPECT_FALSE(store().checkpoint(id));
+  EXPECT_FALSE(store().checkpoint("no-such-job"));
+  const Claim never{id, live().instance, 1};
+  EXPECT_EQ(store().record_checkpoint(never, checkpoint_at(1, never)), ClaimState::lost);
+  EXPECT_FALSE(store().checkpoint(id));
+
+  const Claim first = claim_of(*store().claim_next(live()));
+  EXPECT_EQ(store().record_checkpoint(first, checkpoint_at(10, first)), ClaimState::held);
+  EXPECT_EQ(store().record_checkpoint(first, checkpoint_at(20, first)), ClaimState::held);
+  auto kept = store().checkpoint(id);
+  ASSERT_TRUE(kept);
+  EXPECT_EQ(kept->file, checkpoint_at(20, first).file);
+  EXPECT_EQ(kept->step, 20);
+  EXPECT_DOUBLE_EQ(kept->time, 10.0);
+  EXPECT_EQ(kept->size, 1020);
+  EXPECT_EQ(kept->sha256, std::string(64, 'c'));
+  EXPECT_EQ(kept->written, "2026-12-02T12:00:00.000Z");
+
+  // Requeued (graceful stop): kept, and the next claim resumes from it.
+  EXPECT_EQ(store().requeue(first), ClaimState::held);
+  EXPECT_EQ(store().checkpoint(id)->step, 20);
+  EXPECT_EQ(store().record_checkpoint(first, checkpoint_at(30, first)), ClaimState::lost);
+  const Claim second = claim_of(*store().claim_next(dead("crashed")));
+  EXPECT_EQ(store().checkpoint(id)->step, 20);
+  EXPECT_EQ(store().record_checkpoint(second, checkpoint_at(40, second)), ClaimState::held);
+  // Recovered after a crash: kept; the crashed claim's writes are refused.
+  ASSERT_EQ(store().recover(5, 0.0).requeued.size(), 1u);
+  EXPECT_EQ(store().checkpoint(id)->step, 40);
+  const Claim third = claim_of(*store().claim_next(live()));
+  EXPECT_EQ(store().record_checkpoint(second, checkpoint_at(50, second)), ClaimState::lost);
+  EXPECT_EQ(store().checkpoint(id)->file, checkpoint_at(40, second).file);
+  close();  // durable
+  EXPECT_EQ(store().checkpoint(id)->step, 40);
+  EXPECT_EQ(store().record_checkpoint(third, checkpoint_at(60, third)), ClaimState::held);
+
+  EXPECT_EQ(store().finish(third, JobEnd{JobStatus::successful, "finished", "", {}, 1}),
+            ClaimState::held);
+  EXPECT_FALSE(store().checkpoint(id));
+  EXPECT_EQ(store().record_checkpoint(third, checkpoint_at(70, third)), ClaimState::lost);
+  EXPECT_FALSE(store().checkpoint(id));
+}
+
+TEST_P(StoreContract, ACancelledOrDeletedJobForgetsItsCheckpointAndRefusesNewOnes) {
+  for (bool deleted : {false, true}) {
+    const auto id = store().submit(job("stopped"), 10).job.id;
+    const Claim claim = claim_of(*store().claim_next(live()));
+    EXPECT_EQ(store().record_checkpoint(claim, checkpoint_at(5, claim)), ClaimState::held);
+    if (deleted)
+      store().dismiss(id);
+    else
+      store().cancel(id);
+    EXPECT_FALSE(store().checkpoint(id)) << (deleted ? "deleted" : "cancelled");
+    EXPECT_EQ(store().record_checkpoint(claim, checkpoint_at(6, claim)), ClaimState::dismissed);
+    EXPECT_FALSE(store().checkpoint(id));
+  }
+}
+
+TEST_P(StoreContract, AJobFailedByRecoveryForgetsItsCheckpoint) {
+  const auto id = store().submit(job("crashing"), 10).job.id;
+  const Claim claim = claim_of(*store().claim_next(dead("crashed")));
+  EXPECT_EQ(store().record_checkpoint(claim, checkpoint_at(5, claim)), ClaimState::held);
+  ASSERT_EQ(store().recover(1, 0.0).failed.size(), 1u);  // attempts 1 >= max 1
+  EXPECT_FALSE(store().checkpoint(id));
 }
 
 TEST_P(StoreContract, ConcurrentWritersNeverFail) {

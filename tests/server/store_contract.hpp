@@ -2,8 +2,8 @@
 //
 // The tests in store_contract.cpp are value-parameterised over a
 // `StoreBackend`: a name and a function that opens the backend's store on a
-// fresh scratch location (a folder for SQLite; a PostgreSQL backend would
-// derive a database from it) with the test's clock (`advance` ages jobs
+// fresh scratch location (a folder for SQLite; the PostgreSQL backend
+// derives a schema of the test database from it) with the test's clock (`advance` ages jobs
 // without sleeping). A backend runs the suite with one line:
 //   INSTANTIATE_TEST_SUITE_P(Sqlite, StoreContract, ::testing::Values(StoreBackend{...}));
 // Everything here goes through the JobStore interface only: what a store
@@ -28,6 +28,10 @@ struct StoreBackend {
   /// Opens the store kept at `scratch` (the same location each call),
   /// reading the time from `clock`.
   std::unique_ptr<JobStore> (*open)(const std::filesystem::path& scratch, WallClock clock);
+  /// Why the backend cannot run here ("" or null: it can); the tests skip
+  /// with that reason. A backend that must run (PostgreSQL under CI) says ""
+  /// and lets open() fail instead.
+  std::string (*unavailable)() = nullptr;
 };
 
 /// Prints the backend's name in failure messages.

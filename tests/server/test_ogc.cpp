@@ -307,12 +307,12 @@ TEST_F(OgcTest, AFullQueueIs503AndTheTokenGuardsEveryOgcRoute) {
 
 TEST_F(OgcTest, AllowListsTheOgcMethods) {
   start();
-  for (const auto& [path, allow] :
-       std::vector<std::pair<std::string, std::string>>{{"/", "GET, HEAD"},
-                                                        {"/conformance", "GET, HEAD"},
-                                                        {"/processes", "GET, HEAD"},
-                                                        {"/processes/hmpm", "GET, HEAD"},
-                                                        {"/processes/hmpm/execution", "POST"}}) {
+  for (const auto& [path, allow] : std::vector<std::pair<std::string, std::string>>{
+           {"/", "GET, HEAD, OPTIONS"},
+           {"/conformance", "GET, HEAD, OPTIONS"},
+           {"/processes", "GET, HEAD, OPTIONS"},
+           {"/processes/hmpm", "GET, HEAD, OPTIONS"},
+           {"/processes/hmpm/execution", "POST, OPTIONS"}}) {
     auto res = client_->Put(path.c_str(), "{}", "application/json");
     ASSERT_TRUE(res);
     EXPECT_EQ(res->status, 405) << path;

@@ -272,14 +272,14 @@ TEST_F(RoutesTest, AllowListsExactlyTheMethodsServed) {
   start();
   const std::string job = "/jobs/00000000-0000-4000-8000-000000000000";
   const std::vector<std::pair<std::string, std::string>> expected{
-      {"/health", "GET, HEAD"},
-      {"/metrics", "GET, HEAD"},
-      {"/jobs", "GET, HEAD, POST"},
-      {job, "GET, HEAD, DELETE"},
-      {job + "/spec", "GET, HEAD"},
-      {job + "/results", "GET, HEAD"},
-      {job + "/results/summary.json", "GET, HEAD"},
-      {job + "/events", "GET, HEAD"},
+      {"/health", "GET, HEAD, OPTIONS"},
+      {"/metrics", "GET, HEAD, OPTIONS"},
+      {"/jobs", "GET, HEAD, POST, OPTIONS"},
+      {job, "GET, HEAD, DELETE, OPTIONS"},
+      {job + "/spec", "GET, HEAD, OPTIONS"},
+      {job + "/results", "GET, HEAD, OPTIONS"},
+      {job + "/results/summary.json", "GET, HEAD, OPTIONS"},
+      {job + "/events", "GET, HEAD, OPTIONS"},
   };
   for (const auto& [path, allow] : expected) {
     auto res = client_->Patch(path.c_str(), "{}", "application/json");
@@ -469,14 +469,17 @@ TEST_F(RoutesTest, EventStreamsSendHeartbeatsWhenNothingChanges) {
   EXPECT_EQ(client_->Delete(("/jobs/" + busy).c_str())->status, 200);
 }
 
-TEST_F(RoutesTest, StoreFailuresAre500WithoutInternalText) {
+// A failing store is the server's trouble, not a bug: 503 store-unavailable
+// with Retry-After (507 when for want of space), and no internal text.
+TEST_F(RoutesTest, StoreFailuresAre503WithRetryAfterWithoutInternalText) {
   start();
   sqlite3* db = nullptr;
   ASSERT_EQ(sqlite3_open((dir_ / "db" / "hmpm.sqlite").c_str(), &db), SQLITE_OK);
   sqlite3_exec(db, "DROP TABLE results; DROP TABLE jobs;", nullptr, nullptr, nullptr);
   sqlite3_close(db);
   auto res = client_->Get("/jobs");
-  expect_problem(res, 500, "internal-error");
+  expect_problem(res, 503, "store-unavailable");
+  EXPECT_EQ(res->get_header_value("Retry-After"), "10");
   EXPECT_EQ(res->body.find("no such table"), std::string::npos) << res->body;
   for (const auto& [name, value] : res->headers) {
     EXPECT_EQ(value.find("no such table"), std::string::npos) << name << ": " << value;
@@ -787,6 +790,44 @@ TEST_F(RoutesTest, ShortIdPrefixesNameOneJobAndAmbiguousOnesAreRefused) {
   expect_problem(client_->Get("/jobs/abc"), 404, "not-found");  // fewer than 4 characters
   EXPECT_EQ(client_->Delete(("/jobs/" + short_id).c_str())->status, 200);
   EXPECT_EQ(json_of(client_->Get(("/jobs/" + id).c_str())->body)["status"], "dismissed");
+}
+
+// Issue 22 items 6 and 7: a job over a limit of the server is refused at
+// submit (and by /validate) with 422 limit-exceeded naming the limit, its
+// value, the job's estimate and the option; nothing is stored.
+TEST_F(RoutesTest, JobOverALimitIsRefusedNamingTheLimitAndItsOption) {
+  ServiceConfig c = config();
+  c.max_particle_steps = 1000;  // the small spec has 13 particles x 50 steps = 650
+  c.max_job_memory = 1 << 20;   // below the estimate's 16 MiB process base
+  start(c);
+  const std::string spec = small_spec("small", 0.1);  // 100 steps: 1300 particle-steps
+  for (const char* path : {"/jobs", "/validate"}) {
+    auto res = client_->Post(path, spec, "application/json");
+    ASSERT_TRUE(res);
+    ASSERT_EQ(res->status, 422) << path << ": " << res->body;
+    const Json doc = json_of(res->body);
+    EXPECT_EQ(doc["type"], "limit-exceeded");
+    ASSERT_EQ(doc["limits"].size(), 2u) << res->body;
+    EXPECT_EQ(doc["limits"][0]["limit"], "max_particle_steps");
+    EXPECT_EQ(doc["limits"][0]["option"], "--max-particle-steps");
+    EXPECT_EQ(doc["limits"][0]["value"], 1000.0);
+    EXPECT_EQ(doc["limits"][0]["estimate"], 1300.0);
+    EXPECT_EQ(doc["limits"][1]["limit"], "max_job_memory");
+    EXPECT_EQ(doc["limits"][1]["option"], "--max-job-memory");
+    EXPECT_NE(doc["detail"].get<std::string>().find("--max-particle-steps"), std::string::npos);
+  }
+  EXPECT_EQ(json_of(client_->Get("/jobs")->body)["numberReturned"], 0);
+}
+
+TEST_F(RoutesTest, FullQueueIsAnsweredBeforeTheSpecIsRead) {
+  ServiceConfig c = config();
+  c.max_queue = 0;
+  start(c);
+  // Not even JSON: a 503 queue-full, not a 400, shows nothing was parsed.
+  auto res = client_->Post("/jobs", "{not json", "application/json");
+  ASSERT_TRUE(res);
+  EXPECT_EQ(res->status, 503) << res->body;
+  EXPECT_EQ(json_of(res->body)["type"], "queue-full");
 }
 
 TEST_F(RoutesTest, ValidateAnswersValidWithWarningsAndCostOrTheInvalidSpecProblem) {

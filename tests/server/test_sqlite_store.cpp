@@ -6,6 +6,8 @@
 #include <sqlite3.h>
 #include <unistd.h>
 
+#include <fstream>
+
 #include "sqlite_migrations.hpp"
 #include "store/sqlite/migrate.hpp"
 #include "store_contract.hpp"
@@ -84,6 +86,50 @@ TEST_F(SqliteStoreTest, RefusesADatabaseWithANewerSchema) {
   EXPECT_THROW(open_sqlite_store(db_path()), StoreFailure);
 }
 
+// SQLite would take an empty file for a new database: an emptied file must
+// not quietly become an empty queue.
+TEST_F(SqliteStoreTest, RefusesAnEmptyFileSayingSo) {
+  { std::ofstream touch(db_path()); }
+  try {
+    open_sqlite_store(db_path());
+    FAIL() << "an empty file was opened as a database";
+  } catch (const StoreFailure& e) {
+    EXPECT_NE(std::string(e.what()).find("is an empty file (0 bytes)"), std::string::npos)
+        << e.what();
+  }
+  EXPECT_EQ(std::filesystem::file_size(db_path()), 0u);  // left as it was
+}
+
+// Pages overwritten with garbage (a bad disk, a torn copy): the integrity
+// check at open refuses the file instead of serving half of it.
+TEST_F(SqliteStoreTest, RefusesADamagedFileAfterItsIntegrityCheck) {
+  {
+    auto store = open_sqlite_store(db_path());
+    NewJob j = job("00000000-0000-4000-8000-000000000000");
+    for (int i = 0; i < 50; ++i) {
+      j.id[34] = static_cast<char>('0' + i / 10);
+      j.id[35] = static_cast<char>('0' + i % 10);
+      store->submit(j, 100);
+    }
+  }
+  const auto size = std::filesystem::file_size(db_path());
+  ASSERT_GT(size, 4u * 4096u);
+  {
+    std::fstream f(db_path(), std::ios::in | std::ios::out | std::ios::binary);
+    const std::string garbage(size - 4096, '\x5a');
+    f.seekp(4096);  // every page but the header's
+    f.write(garbage.data(), static_cast<std::streamsize>(garbage.size()));
+  }
+  try {
+    open_sqlite_store(db_path());
+    FAIL() << "a damaged file was opened";
+  } catch (const StoreFailure& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find(db_path().string()), std::string::npos) << what;
+    EXPECT_NE(what.find("restore it from a backup"), std::string::npos) << what;
+  }
+}
+
 TEST_F(SqliteStoreTest, MigratesAnUnrelatedVersionZeroFile) {
   query("CREATE TABLE unrelated (x)");  // an existing file at user_version 0
   auto store = open_sqlite_store(db_path());
@@ -102,7 +148,7 @@ TEST_F(SqliteStoreTest, UpgradesAVersionOneFileAndRecoversItsRunningJob) {
   std::string versions;  // every migration after the first ran
   for (const auto& m : sqlite::migrations) versions += std::to_string(m.version) + ";";
   EXPECT_EQ(query("SELECT version FROM schema_migrations ORDER BY version"), versions);
-  const auto report = store->recover(3);
+  const auto report = store->recover(3, 0.0);
   ASSERT_EQ(report.requeued.size(), 1u);
   EXPECT_EQ(store->find(report.requeued[0])->name, "old");
 }
@@ -139,10 +185,10 @@ TEST_F(SqliteStoreTest, LeasesOfAnEarlierProcessEndWhenTheLockIsOurs) {
     auto store = open_sqlite_store(db_path());
     id = store->submit(job("00000000-0000-4000-8000-000000000003"), 10).job.id;
     store->claim_next(Claimant{"earlier-process", 600.0});
-    EXPECT_TRUE(store->recover(3).requeued.empty());  // live while that store is open
+    EXPECT_TRUE(store->recover(3, 0.0).requeued.empty());  // live while that store is open
   }
   auto store = open_sqlite_store(db_path());
-  const auto report = store->recover(3);
+  const auto report = store->recover(3, 0.0);
   ASSERT_EQ(report.requeued.size(), 1u);
   EXPECT_EQ(report.requeued[0], id);
 }

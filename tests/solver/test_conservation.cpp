@@ -3,9 +3,11 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <numeric>
+#include <thread>
 
 #include "hmpm/run.hpp"
 #include "problems.hpp"
@@ -351,6 +353,50 @@ TEST(Control, CancellationStopsWithinAStepAndProgressIsReported) {
   EXPECT_GT(seen[10].total_steps, 1000);
   EXPECT_NEAR(seen[10].fraction, seen[10].time / 100.0, 1e-15);
   EXPECT_NE(r.message.find("cancelled"), std::string::npos);
+}
+
+// Issue 22 item 6: set-up (particle generation, initial-field formulas)
+// honours the cancel flag and the wall-time limit, checked every few
+// hundred particles, not only the time loop.
+TEST(Control, SetUpHonoursCancellationAndTheWallTimeLimit) {
+  hmpm::Problem p = small_block(0.0, 0.0);
+  std::atomic<bool> cancel{false};
+  std::atomic<int> evaluations{0};
+  // An initial field that cancels the run at its first evaluation and,
+  // for the wall-time case, takes 1 ms per particle.
+  bool slow = false;
+  p.bodies[0].initial.velocity[0] = [&](const hmpm::Vec3&) {
+    ++evaluations;
+    if (slow)
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    else
+      cancel = true;
+    return 0.0;
+  };
+  hmpm::RunOptions opt;
+  opt.cancel = &cancel;
+  const hmpm::RunResult cancelled = hmpm::run(p, opt);
+  EXPECT_EQ(cancelled.status, hmpm::RunStatus::cancelled);
+  EXPECT_NE(cancelled.message.find("set-up"), std::string::npos) << cancelled.message;
+  EXPECT_EQ(cancelled.steps, 0);
+  EXPECT_LE(evaluations.load(), 257);  // stopped at the next check
+
+  // The whole grid at 4 x 4 per cell: 1600 particles, 1.6 s of formulas
+  // against a 0.05 s limit; the checks every 256 stop it after ~0.26 s.
+  p.bodies[0].box.min = {0, 0, 0};
+  p.bodies[0].box.max = {1, 1, 0};
+  p.bodies[0].particles_per_cell = 4;
+  ASSERT_EQ(hmpm::count_particles(p), 1600);
+  cancel = false;
+  slow = true;
+  evaluations = 0;
+  hmpm::RunOptions timed;
+  timed.wall_time_limit_s = 0.05;
+  const hmpm::RunResult failed = hmpm::run(p, timed);
+  EXPECT_EQ(failed.status, hmpm::RunStatus::failed);
+  EXPECT_NE(failed.message.find("wall-time limit"), std::string::npos) << failed.message;
+  EXPECT_NE(failed.message.find("set-up"), std::string::npos) << failed.message;
+  EXPECT_LT(evaluations.load(), hmpm::count_particles(p));
 }
 
 }  // namespace

@@ -390,15 +390,38 @@ TEST(SemiImplicit, StableWhenDarcyDominates) {
 // saying what to change (here a load that turns NaN at t = 0.01 s: the
 // predicted velocity, hence the pressure system's right-hand side, is
 // non-finite, and the step reports it before solving or moving anything).
+namespace {
+
+// The Terzaghi column `c` whose load becomes `late` after t = 0.01 s.
+hmpm::Problem column_loaded_late(const Column& c, double late) {
+  hmpm::Problem p = terzaghi(c, 0.02);
+  const double q = c.q;
+  p.tractions[0].traction[c.axis] = [q, late](double t) { return t > 0.01 ? late : -q; };
+  return p;
+}
+
+}  // namespace
+
+// A NaN load is reported as the formula's (the time loop checks load and
+// boundary values before each step), never as a diverged state.
+TEST(SemiImplicit, NaNLoadFailsNamingTheFormula) {
+  Column c;
+  c.cells = 20;
+  const hmpm::RunResult r =
+      hmpm::run(column_loaded_late(c, std::numeric_limits<double>::quiet_NaN()));
+  ASSERT_EQ(r.status, hmpm::RunStatus::failed);
+  const std::string formula = "/tractions/0/traction/" + std::to_string(c.axis);
+  EXPECT_NE(r.message.find("the formula at " + formula + " gave NaN at t = 0.01"),
+            std::string::npos)
+      << r.message;
+  EXPECT_EQ(r.message.find("reduce time.dt"), std::string::npos) << r.message;
+}
+
 TEST(SemiImplicit, NonFiniteStateFailsWithWhatToChange) {
   Column c;
   c.cells = 20;
-  hmpm::Problem p = terzaghi(c, 0.02);
-  const double q = c.q;
-  p.tractions[0].traction[c.axis] = [q](double t) {
-    return t > 0.01 ? std::numeric_limits<double>::quiet_NaN() : -q;
-  };
-  const hmpm::RunResult r = hmpm::run(p);
+  // Finite, but so large that the state overflows.
+  const hmpm::RunResult r = hmpm::run(column_loaded_late(c, -std::numeric_limits<double>::max()));
   ASSERT_EQ(r.status, hmpm::RunStatus::failed);
   EXPECT_NE(r.message.find("became non-finite: the run diverged"), std::string::npos) << r.message;
   EXPECT_NE(r.message.find("What to change: reduce time.dt or time.courant"), std::string::npos)

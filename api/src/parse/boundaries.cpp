@@ -1,11 +1,37 @@
 // boundaries.cpp — the "boundaries" section: grid nodes with prescribed
 // velocity components, pore pressure, rigid ties and wall friction.
+#include <algorithm>
+#include <cmath>
 #include <limits>
 
 #include "parser.hpp"
 
 namespace hmpm::api::parse {
 namespace {
+
+/// Nodes of the selection among those inside `bounds` (a 2D polygon's
+/// bounding box).
+std::int64_t count_selected_nodes(const Problem& p, const NodeSelection& nodes, const Box& bounds) {
+  std::array<std::int64_t, 2> first{0, 0}, last{0, 0};
+  std::array<double, 2> h{0.0, 0.0};
+  for (int a = 0; a < 2; ++a) {
+    h[a] = (p.grid.max[a] - p.grid.min[a]) / p.grid.cells[a];
+    first[a] = std::max<std::int64_t>(
+        0, static_cast<std::int64_t>(std::floor((bounds.min[a] - p.grid.min[a]) / h[a])));
+    last[a] = std::min<std::int64_t>(
+        p.grid.cells[a],
+        static_cast<std::int64_t>(std::ceil((bounds.max[a] - p.grid.min[a]) / h[a])));
+  }
+  std::int64_t n = 0;
+  for (std::int64_t j = first[1]; j <= last[1]; ++j)
+    for (std::int64_t i = first[0]; i <= last[0]; ++i)
+      n += node_selected(p, nodes,
+                         {p.grid.min[0] + static_cast<double>(i) * h[0],
+                          p.grid.min[1] + static_cast<double>(j) * h[1], 0.0})
+               ? 1
+               : 0;
+  return n;
+}
 
 constexpr std::string_view boundary_allowed[] = {"nodes", "velocity", "pore_pressure", "rigid",
                                                  "friction"};
@@ -18,10 +44,15 @@ void read_boundary(ParseContext& c, const json& j, const std::string& path) {
   if (j.contains("nodes")) {
     bool all = false;
     const std::string np = path + "/nodes";
-    if (auto box = read_selection(c, j["nodes"], np, all)) {
+    if (auto box = read_selection(c, j["nodes"], np, all, &b.nodes.polygon)) {
       b.nodes.all = all;
       b.nodes.box = *box;
-      if (!all && c.grid_ok) {
+      if (b.nodes.polygon) {
+        if (c.grid_ok && count_selected_nodes(c.p, b.nodes, *box) == 0)
+          r.error(np + "/polygon",
+                  "selects no grid node (inside or on its boundary); nodes lie at min + i * "
+                  "cell size");
+      } else if (!all && c.grid_ok) {
         double count = 1;
         for (int a = 0; a < c.dim; ++a)
           count *= static_cast<double>(nodes_inside(c.p.grid, a, box->min[a], box->max[a]));

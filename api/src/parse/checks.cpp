@@ -16,6 +16,49 @@ namespace {
 constexpr double max_layout_work = 5e7;
 // Work bound for checks that visit every particle per selection.
 constexpr double max_near_work = 2e8;
+// Work bound for the finiteness checks of formulas, in characters evaluated
+// (one evaluation of a formula costs about its length plus a fixed part:
+// ~1.2 ns per character with muParser's bytecode on the development
+// machine, so the bound is ~60 ms per kind of formula): about a million
+// evaluations of short formulas, fewer of long ones. Without the weight a
+// spec of long formulas cost ~5 s of CPU to validate.
+constexpr double formula_work = 5e7;
+constexpr double formula_overhead_characters = 32;
+
+double evaluation_cost(std::size_t length) {
+  return static_cast<double>(length) + formula_overhead_characters;
+}
+
+// Work bound for filling polygons and prisms: candidate positions x the
+// polygon's vertices (each laying out tests every candidate against every
+// edge; validation lays the bodies out a few times).
+constexpr double max_polygon_work = 2e8;
+
+/// The box a body's particles lie in: its box, or the bounding box of its
+/// polygon or prism (points bodies: unused).
+Box shape_bounds(const Body& body) {
+  Box out = body.box;
+  const std::vector<std::array<double, 2>>* vertices = nullptr;
+  std::array<int, 2> plane{0, 1};
+  if (body.polygon) vertices = &body.polygon->vertices;
+  if (body.prism) {
+    vertices = &body.prism->polygon.vertices;
+    const int axis = body.prism->axis;
+    plane = axis == 0 ? std::array<int, 2>{1, 2}
+                      : (axis == 1 ? std::array<int, 2>{0, 2} : std::array<int, 2>{0, 1});
+    out.min[axis] = body.prism->from;
+    out.max[axis] = body.prism->to;
+  }
+  if (!vertices || vertices->empty()) return out;
+  for (int k = 0; k < 2; ++k) {
+    out.min[plane[k]] = out.max[plane[k]] = vertices->front()[k];
+    for (const auto& v : *vertices) {
+      out.min[plane[k]] = std::min(out.min[plane[k]], v[k]);
+      out.max[plane[k]] = std::max(out.max[plane[k]], v[k]);
+    }
+  }
+  return out;
+}
 
 bool check_particle_budget(ParseContext& c) {
   // Count particles from the layout rule without generating them, so a huge
@@ -37,11 +80,20 @@ bool check_particle_budget(ParseContext& c) {
   double total = 0;
   for (std::size_t b = 0; b < p.bodies.size(); ++b) {
     const Body& body = p.bodies[b];
+    if (body.points) {
+      total += static_cast<double>(body.points->positions.size());
+      continue;
+    }
+    const Box range = shape_bounds(body);
+    const bool shaped = body.polygon || body.prism;
     double n = 1;
     for (int a = 0; a < c.dim; ++a) {
-      const double along =
-          static_cast<double>(cells_inside(p.grid, a, body.box.min[a], body.box.max[a])) *
-          body.particles_per_cell;
+      // A polygon or prism fills at most the sub-cells of the cells meeting
+      // its bounding box.
+      const double cells =
+          shaped ? static_cast<double>(nodes_inside(p.grid, a, range.min[a], range.max[a]) + 1)
+                 : static_cast<double>(cells_inside(p.grid, a, range.min[a], range.max[a]));
+      const double along = cells * body.particles_per_cell;
       if (along > static_cast<double>(c.limits.max_particles)) {
         c.r.error(child_pointer("/bodies", b) + "/particles_per_cell",
                   "body would have " + format_count(along) + " particles along " +
@@ -50,6 +102,19 @@ bool check_particle_budget(ParseContext& c) {
         return false;
       }
       n *= along;
+    }
+    if (shaped) {
+      const std::size_t vertices =
+          body.polygon ? body.polygon->vertices.size() : body.prism->polygon.vertices.size();
+      if (n * static_cast<double>(vertices) > max_polygon_work) {
+        c.r.error(child_pointer("/bodies", b) + (body.polygon ? "/polygon" : "/prism/polygon"),
+                  "filling it tests " + format_count(n) + " sub-cell centres against " +
+                      std::to_string(vertices) + " edges, too much work (" +
+                      format_count(n * static_cast<double>(vertices)) + " > " +
+                      format_count(max_polygon_work) +
+                      "); use fewer vertices, fewer particles per cell or a coarser grid");
+        return false;
+      }
     }
     total += n;
   }
@@ -79,6 +144,51 @@ void resolve_near(ParseContext& c) {
   }
 }
 
+/// Replaces each {"polygon": ...} entry of output.series.particles by the
+/// particles inside or on the polygon (as a traction selects them).
+void resolve_series_polygons(ParseContext& c) {
+  if (c.series_polygons.empty()) return;
+  for (const PendingPolygon& pp : c.series_polygons) {
+    std::vector<ProblemIssue> issues;
+    check_polygon(pp.polygon, Location{}, issues);
+    for (const ProblemIssue& issue : issues)
+      c.r.error(pp.path + "/polygon" + pointer_of_solver_location(issue.where), issue.message);
+  }
+  if (c.r.error_count() > 0) return;
+  std::vector<std::int64_t>& parts = c.p.output.series_particles;
+  const std::vector<Vec3> positions = initial_positions(c.p);
+  if (static_cast<double>(c.series_polygons.size()) * static_cast<double>(positions.size()) >
+      max_near_work) {
+    c.r.error("/output/series/particles", "too many 'polygon' selections over " +
+                                              std::to_string(positions.size()) +
+                                              " particles to resolve; name particles by index");
+    return;
+  }
+  std::vector<std::int64_t> out;
+  std::size_t next = 0;
+  for (std::size_t slot = 0; slot < parts.size(); ++slot) {
+    if (next < c.series_polygons.size() && c.series_polygons[next].slot == slot) {
+      const PendingPolygon& pp = c.series_polygons[next++];
+      Traction as_selection;
+      as_selection.polygon = pp.polygon;
+      const std::size_t before = out.size();
+      for (std::size_t i = 0; i < positions.size(); ++i)
+        if (particle_selected(c.p, as_selection, positions[i]))
+          out.push_back(static_cast<std::int64_t>(i));
+      if (out.size() == before) c.r.error(pp.path + "/polygon", "selects no particle");
+      continue;
+    }
+    out.push_back(parts[slot]);
+  }
+  if (out.size() > static_cast<std::size_t>(c.limits.max_series_particles)) {
+    c.r.error("/output/series/particles", "selects " + std::to_string(out.size()) +
+                                              " particles; the limit is " +
+                                              std::to_string(c.limits.max_series_particles));
+    return;
+  }
+  parts = std::move(out);
+}
+
 void check_traction_selections(ParseContext& c) {
   // A convenience check, skipped when it would cost more than a moment.
   const Problem& p = c.p;
@@ -88,12 +198,8 @@ void check_traction_selections(ParseContext& c) {
     return;
   const std::vector<Vec3> positions = initial_positions(p);
   for (std::size_t k = 0; k < p.tractions.size(); ++k) {
-    const Box& box = p.tractions[k].particles;
     const bool any = std::any_of(positions.begin(), positions.end(), [&](const Vec3& x) {
-      for (int a = 0; a < c.dim; ++a)
-        if (x[a] < box.min[a] - 1e-12 || x[a] > box.max[a] + 1e-12)
-          return false;  // as the solver selects
-      return true;
+      return particle_selected(p, p.tractions[k], x);  // as the solver selects
     });
     if (!any)
       c.r.error(c.traction_paths[k],
@@ -103,9 +209,11 @@ void check_traction_selections(ParseContext& c) {
 }
 
 void check_time_formulas(ParseContext& c) {
-  // At up to 1001 instants over [0, end], about a million evaluations in all.
-  const int intervals = static_cast<int>(std::clamp(
-      1e6 / static_cast<double>(std::max<std::size_t>(c.time_formulas.size(), 1)), 1.0, 1000.0));
+  // At up to 1001 instants over [0, end], within the formula work bound.
+  double per_instant = 0;
+  for (const TimeFormula& tf : c.time_formulas) per_instant += evaluation_cost(tf.length);
+  const int intervals =
+      static_cast<int>(std::clamp(formula_work / std::max(per_instant, 1.0), 1.0, 1000.0));
   for (const TimeFormula& tf : c.time_formulas) {
     for (int k = 0; k <= intervals; ++k) {
       const double t = c.p.time.end * k / intervals;
@@ -125,27 +233,27 @@ void check_time_formulas(ParseContext& c) {
 }
 
 void check_position_formulas(ParseContext& c) {
-  // At every particle of the body, or a regular sample of about a million
-  // evaluations in all when the bodies are large.
+  // At every particle of the body, or a regular sample within the formula
+  // work bound when the bodies are large or the formulas long.
   if (c.position_formulas.empty()) return;
   const Problem& p = c.p;
   std::vector<std::vector<Vec3>> positions(p.bodies.size());
-  double evaluations = 0;
+  double work = 0;
   for (const PositionFormula& pf : c.position_formulas) {
     if (pf.body >= p.bodies.size()) continue;
     if (positions[pf.body].empty()) {
       Problem one;
       one.dimension = p.dimension;
       one.grid = p.grid;
-      Body b;
-      b.box = p.bodies[pf.body].box;
-      b.particles_per_cell = p.bodies[pf.body].particles_per_cell;
-      one.bodies.push_back(b);
+      Body b = p.bodies[pf.body];
+      b.initial = InitialFields{};
+      one.bodies.push_back(std::move(b));
       positions[pf.body] = initial_positions(one);
     }
-    evaluations += static_cast<double>(positions[pf.body].size());
+    work += static_cast<double>(positions[pf.body].size()) * evaluation_cost(pf.length);
   }
-  const std::size_t stride = static_cast<std::size_t>(std::max(1.0, std::ceil(evaluations / 1e6)));
+  const std::size_t stride =
+      static_cast<std::size_t>(std::max(1.0, std::ceil(work / formula_work)));
   for (const PositionFormula& pf : c.position_formulas) {
     if (pf.body >= p.bodies.size()) continue;
     const std::vector<Vec3>& xs = positions[pf.body];
@@ -201,6 +309,7 @@ void check_limits(ParseContext& c) {
 void check_whole_problem(ParseContext& c) {
   if (!check_particle_budget(c)) return;
   resolve_near(c);
+  resolve_series_polygons(c);
   for (const ProblemIssue& issue : check_problem(c.p))
     c.r.error(pointer_of_solver_location(issue.where), issue.message);
   if (c.r.error_count() > 0) return;

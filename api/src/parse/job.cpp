@@ -6,6 +6,9 @@
 // and the solver's warnings. Nothing after parse_job looks anything up by
 // string.
 #include <algorithm>
+#include <cstdio>
+#include <optional>
+#include <utility>
 
 #include "parser.hpp"
 
@@ -21,11 +24,48 @@ constexpr std::string_view top_required[] = {"dimension", "grid", "materials", "
 // At most this many errors are reported (then one line counting the rest).
 constexpr std::size_t max_errors = 1000;
 
+// The first character of `s` (UTF-8, which the JSON parser has checked)
+// that a job name may not hold: C0 and C1 control characters (NUL, line
+// breaks, escape sequences) and the bidirectional controls that make a name
+// show as something else (U+061C, U+200E, U+200F, U+202A-U+202E,
+// U+2066-U+2069). Returns its position (in characters) and code point.
+std::optional<std::pair<std::size_t, char32_t>> forbidden_in_name(std::string_view s) {
+  std::size_t position = 0;
+  for (std::size_t i = 0; i < s.size(); ++position) {
+    const auto lead = static_cast<unsigned char>(s[i]);
+    const int length = lead < 0x80 ? 1 : lead < 0xE0 ? 2 : lead < 0xF0 ? 3 : 4;
+    char32_t cp = length == 1 ? lead : lead & (0x7F >> length);
+    for (int k = 1; k < length && i + k < s.size(); ++k)
+      cp = (cp << 6) | (static_cast<unsigned char>(s[i + k]) & 0x3F);
+    i += static_cast<std::size_t>(length);
+    const bool control = cp < 0x20 || (cp >= 0x7F && cp <= 0x9F);
+    const bool bidi = cp == 0x061C || cp == 0x200E || cp == 0x200F ||
+                      (cp >= 0x202A && cp <= 0x202E) || (cp >= 0x2066 && cp <= 0x2069);
+    if (control || bidi) return std::pair{position, cp};
+  }
+  return std::nullopt;
+}
+
+void read_name(ParseContext& c, const json& j) {
+  auto s = c.r.string(j, "/name", 200);
+  if (!s) return;
+  if (const auto bad = forbidden_in_name(*s)) {
+    char code[16];
+    std::snprintf(code, sizeof code, "U+%04X", static_cast<unsigned>(bad->second));
+    c.r.error("/name", std::string("holds ") + code + " at character " +
+                           std::to_string(bad->first + 1) +
+                           "; a job name may not contain control characters (U+0000-U+001F, "
+                           "U+007F-U+009F) or bidirectional controls (U+061C, U+200E, U+200F, "
+                           "U+202A-U+202E, U+2066-U+2069): remove it");
+    return;
+  }
+  c.name = *s;
+}
+
 void read_root(ParseContext& c, const json& root) {
   SpecReader& r = c.r;
   if (!r.object(root, "", top_allowed, top_required)) return;
-  if (root.contains("name"))
-    if (auto s = r.string(root["name"], "/name", 200)) c.name = *s;
+  if (root.contains("name")) read_name(c, root["name"]);
   if (root.contains("description")) r.string(root["description"], "/description", 100'000);
   if (root.contains("dimension"))
     if (auto d = r.integer(root["dimension"], "/dimension", 1, 3)) c.dim = static_cast<int>(*d);

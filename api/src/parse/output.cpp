@@ -11,7 +11,7 @@ namespace {
 constexpr std::string_view output_allowed[] = {"series", "snapshots"};
 constexpr std::string_view series_allowed[] = {"particles", "fields", "interval"};
 constexpr std::string_view series_required[] = {"particles", "fields"};
-constexpr std::string_view near_allowed[] = {"near"};
+constexpr std::string_view near_allowed[] = {"near", "polygon"};
 constexpr std::string_view snapshots_allowed[] = {"interval", "fields"};
 constexpr std::string_view snapshots_required[] = {"interval"};
 
@@ -48,15 +48,27 @@ void read_series_particles(ParseContext& c, const json& parts, const std::string
     const json& e = parts[i];
     out.series_particles.push_back(-1);
     if (e.is_object()) {
-      if (r.object(e, ip, near_allowed, near_allowed) && e.contains("near"))
+      if (!r.object(e, ip, near_allowed)) continue;
+      if (e.contains("near") == e.contains("polygon")) {
+        r.error(ip, e.contains("near") ? "gives both 'near' and 'polygon'; give one"
+                                       : "needs 'near' or 'polygon'");
+      } else if (e.contains("near")) {
         if (auto at = r.vector(e["near"], ip + "/near", c.dim))
           c.near.push_back({out.series_particles.size() - 1, *at, ip});
+      } else if (c.dim != 2) {
+        r.error(ip + "/polygon",
+                "selects in the (x, y) plane, which needs a 2D problem; this one "
+                "is " +
+                    std::to_string(c.dim) + "D: name particles or use 'near'");
+      } else if (auto poly = read_polygon(c, e["polygon"], ip + "/polygon", {0, 1})) {
+        c.series_polygons.push_back({out.series_particles.size() - 1, std::move(*poly), ip});
+      }
     } else if (e.is_number()) {
       if (auto n = r.integer(e, ip, 0, std::numeric_limits<std::int64_t>::max()))
         out.series_particles.back() = *n;
     } else {
-      r.error(ip, std::string(
-                      "expected a particle index (integer >= 0) or {\"near\": [x, ...]}, got ") +
+      r.error(ip, std::string("expected a particle index (integer >= 0), {\"near\": [x, ...]} or "
+                              "{\"polygon\": [[x, y], ...]}, got ") +
                       e.type_name());
     }
   }

@@ -35,17 +35,28 @@ struct PositionFormula {
   std::size_t body;
   std::string path;
   FieldOfPosition f;
+  std::size_t length = 0;  ///< characters: what one evaluation costs, roughly
 };
 /// A formula of time read from the spec, checked over [0, end].
 struct TimeFormula {
   std::string path;
   FieldOfTime f;
+  std::size_t length = 0;  ///< characters
 };
 /// An output.series particle given as {"near": [...]}, resolved once the
 /// particles are known.
 struct PendingNear {
   std::size_t slot;  ///< index into series_particles
   Vec3 at;
+  std::string path;
+};
+
+/// An output.series particle entry {"polygon": [...]} (2D): every particle
+/// whose initial position lies inside or on it, in numbering order, replaces
+/// the entry once the particles are known.
+struct PendingPolygon {
+  std::size_t slot;  ///< index into series_particles
+  Polygon polygon;
   std::string path;
 };
 
@@ -62,9 +73,12 @@ struct ParseContext {
   bool grid_ok = false;  ///< grid valid: boxes can be checked against it
   std::map<std::string, int> material_index;
   std::vector<PendingNear> near;
+  std::vector<PendingPolygon> series_polygons;
   std::vector<PositionFormula> position_formulas;
   std::vector<TimeFormula> time_formulas;
-  bool damping_formula = false;  ///< local_damping given as a formula of t
+  bool damping_formula = false;         ///< local_damping given as a formula of t
+  std::int64_t formula_characters = 0;  ///< of every formula read so far
+  std::size_t formulas = 0;             ///< formulas read so far
   std::vector<std::string> traction_paths;
   bool any_pore_pressure_bc = false;
   std::string first_pore_pressure_bc;
@@ -89,9 +103,16 @@ void read_output(ParseContext& c, const json& j, const std::string& path);
 // ------------------------------------------------------ shared value readers
 /// {"min": [...], "max": [...]} inside the grid (when the grid is valid).
 std::optional<Box> read_box(ParseContext& c, const json& j, const std::string& path);
-/// {"box": {...}} or "all"; "all" is the whole grid.
+/// [[u, v], ...]: a plane polygon of 3 or more vertices, whose coordinates
+/// are along the axes `plane` (inside the grid when it is valid). Whether it
+/// is simple is checked with the whole Problem (check_problem).
+std::optional<Polygon> read_polygon(ParseContext& c, const json& j, const std::string& path,
+                                    std::array<int, 2> plane);
+/// {"box": {...}}, {"polygon": [[x, y], ...]} (2D) or "all"; "all" is the
+/// whole grid. A polygon is stored in `*polygon` and its bounding box
+/// returned.
 std::optional<Box> read_selection(ParseContext& c, const json& j, const std::string& path,
-                                  bool& all);
+                                  bool& all, std::optional<Polygon>* polygon);
 /// The keys of a box and of a selection object (for the key tables).
 Keys box_key_names();
 Keys selection_key_names();

@@ -1,5 +1,5 @@
 // tractions.cpp — the "tractions" section: surface loads on a face of the
-// particles inside a box.
+// particles inside a box or a polygon.
 #include "parser.hpp"
 
 namespace hmpm::api::parse {
@@ -14,7 +14,8 @@ void read_traction(ParseContext& c, const json& j, const std::string& path) {
   Traction t;
   if (j.contains("particles")) {
     bool all = false;
-    if (auto box = read_selection(c, j["particles"], path + "/particles", all)) t.particles = *box;
+    if (auto box = read_selection(c, j["particles"], path + "/particles", all, &t.polygon))
+      t.particles = *box;
   }
   if (j.contains("face")) {
     if (auto f = r.one_of(j["face"], path + "/face", face_names)) {

@@ -10,6 +10,7 @@
 #include "hmpm/server/service.hpp"
 #include "hmpm/server/store.hpp"
 #include "metrics.hpp"
+#include "validation_gate.hpp"
 #include "worker_pool.hpp"
 
 namespace hmpm::server::http {
@@ -21,6 +22,7 @@ struct Context {
   Metrics& metrics;
   WorkerPool& workers;
   const std::atomic<bool>& stopping;  ///< set by Service::stop()
+  ValidationGate& validation;         ///< turns to parse a spec (POST /jobs, /validate)
 };
 
 }  // namespace hmpm::server::http

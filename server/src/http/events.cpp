@@ -1,7 +1,11 @@
 // events.cpp — GET /jobs/{id}/events: progress as Server-Sent Events.
 //
 // Each stream holds an HTTP thread for its life, so streams are capped
-// (`max_event_streams`, 503 beyond) and end promptly when the service stops.
+// (`max_event_streams`, 503 beyond; below the HTTP thread count, options.cpp),
+// end promptly when the service stops, and end after `event_stream_max_s`
+// (the client reconnects after `retry` and gets the current state), so a
+// client that never reads cannot hold a slot for a job's whole life; a write
+// that cannot go out within httplib's write timeout ends it sooner.
 #include <chrono>
 #include <memory>
 #include <thread>
@@ -22,6 +26,7 @@ struct StreamState {
   int last_progress = -1;
   int sent = 0;
   SteadyClock::time_point last_write = SteadyClock::now();
+  SteadyClock::time_point ends;
 };
 
 // Takes a stream slot; false when the cap is reached.
@@ -47,6 +52,9 @@ void stream_events(Context& c, const httplib::Request& req, httplib::Response& r
   }
   auto state = std::make_shared<StreamState>();
   state->id = id;
+  state->ends =
+      SteadyClock::now() + std::chrono::duration_cast<SteadyClock::duration>(
+                               std::chrono::duration<double>(c.config.event_stream_max_s));
   res.set_header("Cache-Control", "no-cache");
   res.set_header("X-Accel-Buffering", "no");
   // httplib calls the provider until it signals done (or a write fails); each
@@ -88,7 +96,7 @@ void stream_events(Context& c, const httplib::Request& req, httplib::Response& r
           while (SteadyClock::now() < until && !c.stopping) {
             std::this_thread::sleep_for(std::chrono::milliseconds(25));
           }
-          if (c.stopping) sink.done();
+          if (c.stopping || SteadyClock::now() >= state->ends) sink.done();
           return true;
         } catch (const std::exception& e) {
           log_line({{"event", "error"}, {"job", state->id}, {"detail", e.what()}});

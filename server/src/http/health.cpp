@@ -1,14 +1,33 @@
 // health.cpp — GET /health (no token: for load balancers) and GET /metrics.
 #include "handlers.hpp"
+#include "hmpm/server/options.hpp"
 #include "problem.hpp"
 
 namespace hmpm::server::http {
 
+// Ready means the database can be read and written (the store's probe);
+// the answer names which failed but not the server's paths (no token here).
 void get_health(Context& c, const httplib::Request&, httplib::Response& res) {
   try {
     c.store.probe();
-    send_json(res, 200, Json{{"status", "ok"}});
+    Json doc{{"status", "ok"}};
+    if (c.config.token.empty() && !is_loopback_host(c.config.host)) {
+      doc["warning"] =
+          "no token on a non-loopback address (--allow-no-token): the API is open "
+          "to anyone who can reach it";
+    }
+    send_json(res, 200, doc);
+  } catch (const StoreFailure& e) {
+    const std::string what = e.what();
+    const bool unwritable = what.find("cannot be written") != std::string::npos;
+    res.set_header("Retry-After", std::to_string(store_retry_after_s));
+    send_json(res, 503,
+              Json{{"status", "unavailable"},
+                   {"detail", e.no_space() ? "no space left: the database cannot be written"
+                                           : (unwritable ? "the database cannot be written"
+                                                         : "the database cannot be read")}});
   } catch (const std::exception&) {
+    res.set_header("Retry-After", std::to_string(store_retry_after_s));
     send_json(res, 503, Json{{"status", "unavailable"}, {"detail", "the database cannot be read"}});
   }
 }

@@ -10,6 +10,8 @@
 #include "digest.hpp"
 #include "documents.hpp"
 #include "handlers.hpp"
+#include "hmpm/format.hpp"
+#include "job_limits.hpp"
 #include "job_log.hpp"
 #include "problem.hpp"
 #include "run_log.hpp"
@@ -30,17 +32,25 @@ JobCost cost_of(const hmpm::api::CostEstimate& c) {
                  .dt = c.dt};
 }
 
-// The cost document with the wall-time estimate of every scheme, from
-// this server's calibration (POST /validate and the 201 of POST /jobs).
-Json cost_with_estimate(const Context& c, const hmpm::api::ParsedJob& job) {
+// The estimate with this server's calibration and threads per job: what
+// the limits are checked against and the 201 and /validate show.
+hmpm::api::CostEstimate server_estimate(const Context& c, const hmpm::api::ParsedJob& job) {
   hmpm::api::Calibration calibration;
   if (c.config.seconds_per_particle_step > 0) {
     calibration.seconds_per_particle_step = c.config.seconds_per_particle_step;
     calibration.measured = true;
   }
   calibration.threads = std::max(c.config.threads_per_job, 1);
-  const hmpm::api::CostEstimate cost = hmpm::api::estimate_cost(job.problem, calibration);
+  return hmpm::api::estimate_cost(job.problem, calibration);
+}
+
+// The cost document with the wall-time estimate of every scheme, from
+// this server's calibration (POST /validate and the 201 of POST /jobs).
+Json cost_with_estimate(const Context& c, const hmpm::api::ParsedJob& job) {
+  const hmpm::api::CostEstimate cost = server_estimate(c, job);
+  const hmpm::api::Calibration& calibration = cost.calibration;
   Json doc = cost_document(cost_of(cost));
+  doc["threads"] = cost.threads;
   doc["scheme"] = hmpm::scheme_name(cost.scheme);
   doc["wall_seconds"] = cost.wall_seconds;
   Json schemes = Json::array();
@@ -80,6 +90,37 @@ void send_invalid_spec(httplib::Response& res, const std::vector<hmpm::api::Spec
                Json{{"errors", spec_issues(errors)}});
 }
 
+// 422 limit-exceeded when the job's estimate is over a limit of this
+// server (job_limits.hpp); returns whether it answered.
+bool refuse_over_limits(const Context& c, httplib::Response& res,
+                        const hmpm::api::CostEstimate& cost) {
+  const std::vector<LimitExceeded> over = exceeded_limits(cost, c.config);
+  if (over.empty()) return false;
+  Json limits = Json::array();
+  std::string detail;
+  for (const LimitExceeded& l : over) {
+    limits.push_back(Json{{"limit", l.limit},
+                          {"value", l.value},
+                          {"estimate", l.estimate},
+                          {"unit", l.unit},
+                          {"option", l.option}});
+    detail += (detail.empty() ? "" : "; ") + l.limit + ": the job's estimate is " +
+              hmpm::format_significant(l.estimate, 3) + " " + l.unit + ", the limit " +
+              hmpm::format_significant(l.value, 3) + " (hmpm-server " + l.option + ")";
+  }
+  send_problem(res, 422, "limit-exceeded", "Job over this server's limits", detail,
+               Json{{"limits", std::move(limits)}});
+  return true;
+}
+
+// 503 validation-busy: every validation turn is taken (validation_gate.hpp).
+void send_validation_busy(const Context& c, httplib::Response& res) {
+  res.set_header("Retry-After", "2");
+  send_problem(res, 503, "validation-busy", "Too many specs being validated",
+               "the server is validating " + std::to_string(c.validation.admitted_max()) +
+                   " job specs already; retry in a moment");
+}
+
 void log_dismissal(const std::string& id, JobStatus from, const char* how) {
   log_line({{"event", "job"},
             {"job", id},
@@ -117,6 +158,24 @@ std::optional<JobRecord> find_job(Context& c, const std::string& ref, httplib::R
   return job;
 }
 
+namespace {
+
+// Jobs waiting to run (status accepted).
+std::int64_t queued_jobs(Context& c) {
+  const StatusCounts counts = c.store.count_by_status();
+  const auto it = counts.find(JobStatus::accepted);
+  return it == counts.end() ? 0 : it->second;
+}
+
+void send_queue_full(const Context& c, httplib::Response& res) {
+  res.set_header("Retry-After", "30");
+  send_problem(
+      res, 503, "queue-full", "Queue full",
+      "the queue holds " + std::to_string(c.config.max_queue) + " jobs already; retry later");
+}
+
+}  // namespace
+
 void post_job(Context& c, const httplib::Request& req, httplib::Response& res,
               const std::string& body) {
   submit_job(c, req, res, body, body);
@@ -135,14 +194,23 @@ void submit_job(Context& c, const httplib::Request& req, httplib::Response& res,
                         "Idempotency-Key must be at most 255 characters");
   }
 
-  const hmpm::api::ParseResult parsed = hmpm::api::parse_job(spec, c.limits);
+  // A full queue is answered before any validation work: a count, not a parse.
+  if (queued_jobs(c) >= c.config.max_queue) return send_queue_full(c, res);
+  hmpm::api::ParseResult parsed;
+  {
+    const ValidationGate::Turn turn = c.validation.enter();
+    if (!turn) return send_validation_busy(c, res);
+    parsed = hmpm::api::parse_job(spec, c.limits);
+  }
   if (!parsed.ok() || !parsed.job) return send_invalid_spec(res, parsed.errors);
+  const hmpm::api::CostEstimate estimate = server_estimate(c, *parsed.job);
+  if (refuse_over_limits(c, res, estimate)) return;
 
   NewJob job;
   job.id = new_uuid_v4();
   job.name = parsed.job->name;
   job.spec = spec;
-  job.cost = cost_of(parsed.job->cost);
+  job.cost = cost_of(estimate);
   job.idempotency_key = key;
   if (!key.empty()) job.body_sha256 = sha256_hex(body);
   const SubmitResult submitted = c.store.submit(job, c.config.max_queue);
@@ -172,10 +240,7 @@ void submit_job(Context& c, const httplib::Request& req, httplib::Response& res,
                           "this Idempotency-Key was used for a different job spec",
                           Json{{"jobID", submitted.job.id}});
     case SubmitOutcome::queue_full:
-      res.set_header("Retry-After", "30");
-      return send_problem(
-          res, 503, "queue-full", "Queue full",
-          "the queue holds " + std::to_string(c.config.max_queue) + " jobs already; retry later");
+      return send_queue_full(c, res);
   }
 }
 
@@ -242,8 +307,16 @@ void list_jobs(Context& c, const httplib::Request& req, httplib::Response& res) 
 
 void validate_spec(Context& c, const httplib::Request&, httplib::Response& res,
                    const std::string& body) {
-  const hmpm::api::ParseResult parsed = hmpm::api::parse_job(body, c.limits);
+  hmpm::api::ParseResult parsed;
+  {
+    const ValidationGate::Turn turn = c.validation.enter();
+    if (!turn) return send_validation_busy(c, res);
+    parsed = hmpm::api::parse_job(body, c.limits);
+  }
   if (!parsed.ok() || !parsed.job) return send_invalid_spec(res, parsed.errors);
+  // A spec over a limit of this server is valid but would be refused: said
+  // here as POST /jobs would say it.
+  if (refuse_over_limits(c, res, server_estimate(c, *parsed.job))) return;
   send_json(res, 200,
             Json{{"valid", true},
                  {"warnings", spec_issues(parsed.job->warnings)},

@@ -41,6 +41,18 @@ void send_too_large(httplib::Response& res, std::size_t limit_bytes) {
                "the request body exceeds " + std::to_string(limit_bytes) + " bytes");
 }
 
+void send_store_failure(httplib::Response& res, bool no_space) {
+  res.set_header("Retry-After", std::to_string(store_retry_after_s));
+  if (no_space) {
+    return send_problem(res, 507, "insufficient-storage", "Insufficient storage",
+                        "no space left for the database (disk full, quota or file-size limit): "
+                        "nothing was stored; retry later");
+  }
+  send_problem(res, 503, "store-unavailable", "Store unavailable",
+               "the database cannot be written or read right now; nothing was stored, retry "
+               "later");
+}
+
 void send_default_problem(httplib::Response& res) {
   switch (res.status) {
     case 400:

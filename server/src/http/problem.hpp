@@ -38,6 +38,15 @@ void send_invalid_parameter(httplib::Response& res, const std::string& detail,
 /// 413 payload-too-large naming the limit.
 void send_too_large(httplib::Response& res, std::size_t limit_bytes);
 
+/// How long a client should wait before retrying when the store cannot
+/// write (`Retry-After` of 503 store-unavailable and 507 insufficient-storage).
+inline constexpr int store_retry_after_s = 10;
+
+/// 507 insufficient-storage (`no_space`: the disk or a size limit is full) or
+/// 503 store-unavailable (any other database failure), with Retry-After;
+/// nothing of the request was stored.
+void send_store_failure(httplib::Response& res, bool no_space);
+
 /// The problem document for a status httplib chose by itself (400, 404, 413, 414 ...).
 void send_default_problem(httplib::Response& res);
 

@@ -2,9 +2,13 @@
 //
 // Only names recorded in the manifest are served: no path is ever built from
 // anything else the client sent.
+#include <sys/stat.h>
+
 #include <array>
 #include <fstream>
 #include <memory>
+#include <sstream>
+#include <string_view>
 
 #include "documents.hpp"
 #include "handlers.hpp"
@@ -38,6 +42,61 @@ std::optional<JobRecord> finished_job(Context& c, const std::string& ref, httpli
   return job;
 }
 
+// The ETag: the manifest's SHA-256 and the file's identity on disk (inode,
+// modification time), so a file rewritten in place, even with the same
+// size, gets a new one.
+std::string etag_of(const ResultFile& file, const struct stat& st) {
+  std::ostringstream tag;
+  tag << '"' << file.sha256 << '-' << std::hex << st.st_ino << '-'
+      << (static_cast<long long>(st.st_mtim.tv_sec) * 1'000'000'000LL + st.st_mtim.tv_nsec) << '"';
+  return tag.str();
+}
+
+// If-None-Match with the weak comparison RFC 9110 asks for: a list of
+// entity tags, each possibly W/-prefixed, or "*".
+bool none_match(const std::string& header, const std::string& etag) {
+  std::string_view rest = header;
+  while (!rest.empty()) {
+    const auto comma = rest.find(',');
+    std::string_view item = rest.substr(0, comma);
+    rest = comma == std::string_view::npos ? std::string_view() : rest.substr(comma + 1);
+    while (!item.empty() && (item.front() == ' ' || item.front() == '\t')) item.remove_prefix(1);
+    while (!item.empty() && (item.back() == ' ' || item.back() == '\t')) item.remove_suffix(1);
+    if (item == "*") return true;
+    if (item.substr(0, 2) == "W/") item.remove_prefix(2);
+    if (item == etag) return true;
+  }
+  return false;
+}
+
+struct Span {
+  std::size_t offset = 0;
+  std::size_t length = 0;
+};
+
+// The part of a `size`-byte file to send for the request's Range (parsed by
+// httplib into req.ranges): the whole file for none, or for several ranges
+// (answered 200 with everything, which RFC 9110 allows); nullopt when the one
+// range lies past the end (416).
+std::optional<Span> requested_span(const httplib::Request& req, std::size_t size, bool& partial) {
+  partial = false;
+  if (req.ranges.size() != 1) return Span{0, size};
+  const auto [first, last] = req.ranges.front();
+  std::size_t from = 0;
+  std::size_t to = 0;  // inclusive
+  if (first < 0) {     // bytes=-N: the last N bytes
+    if (last <= 0 || size == 0) return std::nullopt;
+    from = size - std::min(size, static_cast<std::size_t>(last));
+    to = size - 1;
+  } else {
+    from = static_cast<std::size_t>(first);
+    if (from >= size) return std::nullopt;
+    to = last < 0 ? size - 1 : std::min(size - 1, static_cast<std::size_t>(last));
+  }
+  partial = true;
+  return Span{from, to - from + 1};
+}
+
 }  // namespace
 
 void get_manifest(Context& c, const httplib::Request& req, httplib::Response& res) {
@@ -66,28 +125,48 @@ void get_result_file(Context& c, const httplib::Request& req, httplib::Response&
   if (!file)
     return send_not_found(res, "job " + job->id + " has no result file named '" + name + "'");
   const auto path = c.workers.job_dir(job->id) / file->name;
-  std::error_code ec;
-  const auto size = std::filesystem::file_size(path, ec);
+  struct stat st {};
   auto in = std::make_shared<std::ifstream>(path, std::ios::binary);
-  if (ec || !*in || static_cast<std::int64_t>(size) != file->size) {
+  if (::stat(path.c_str(), &st) != 0 || !*in ||
+      static_cast<std::int64_t>(st.st_size) != file->size) {
     log_line({{"event", "error"},
               {"job", job->id},
               {"detail", "result file missing or changed: " + file->name}});
     return send_problem(res, 500, "result-missing", "Result file missing",
                         "the result file is missing or was changed on the server");
   }
-  const std::string etag = "\"" + file->sha256 + "\"";
+  const auto size = static_cast<std::size_t>(st.st_size);
+  const std::string etag = etag_of(*file, st);
   res.set_header("ETag", etag);
-  if (req.get_header_value("If-None-Match") == etag) {
+  res.set_header("Accept-Ranges", "bytes");
+  if (req.has_header("If-None-Match") && none_match(req.get_header_value("If-None-Match"), etag)) {
     res.status = 304;
     return;
   }
+  bool partial = false;
+  const auto span = requested_span(req, size, partial);
+  // httplib applies req.ranges to the response itself, without checking them
+  // against the size (a range past the end gave 206 and a broken body): the
+  // range is served here, so it is cleared. The Request is a non-const local
+  // of httplib's process_request, so the cast is safe.
+  const_cast<httplib::Request&>(req).ranges.clear();
+  if (!span) {
+    res.set_header("Content-Range", "bytes */" + std::to_string(size));
+    return send_problem(res, 416, "range-not-satisfiable", "Range not satisfiable",
+                        "the file has " + std::to_string(size) + " bytes");
+  }
+  if (partial) {
+    res.status = 206;
+    res.set_header("Content-Range", "bytes " + std::to_string(span->offset) + "-" +
+                                        std::to_string(span->offset + span->length - 1) + "/" +
+                                        std::to_string(size));
+  }
   res.set_header("Content-Disposition", "attachment; filename=\"" + file->name + "\"");
   res.set_content_provider(
-      size, file->media_type,
-      [in](std::size_t offset, std::size_t length, httplib::DataSink& sink) {
+      span->length, file->media_type,
+      [in, base = span->offset](std::size_t offset, std::size_t length, httplib::DataSink& sink) {
         std::array<char, 1 << 16> buffer{};
-        in->seekg(static_cast<std::streamoff>(offset));
+        in->seekg(static_cast<std::streamoff>(base + offset));
         in->read(buffer.data(), static_cast<std::streamsize>(std::min(length, buffer.size())));
         const auto n = in->gcount();
         if (n <= 0) return false;

@@ -5,6 +5,7 @@
 #include <array>
 #include <stdexcept>
 
+#include "connection.hpp"
 #include "handlers.hpp"
 #include "problem.hpp"
 
@@ -94,6 +95,7 @@ std::string Router::allowed_methods(const std::string& path) const {
       break;
     }
   }
+  if (!allow.empty()) allow += ", OPTIONS";
   return allow;
 }
 
@@ -181,6 +183,12 @@ void Router::register_route(httplib::Server& server, const Compiled& c) const {
                         });
                         if (!complete) {
                           if (too_large || res.status == 413) return send_too_large(res, limit);
+                          close_after_response();  // the rest of the body is still on the wire
+                          if (current_stream_limit() == StreamLimit::body_timeout) {
+                            return send_problem(res, 408, "request-timeout", "Request timeout",
+                                                "the request body did not arrive within the "
+                                                "server's time limit");
+                          }
                           return send_problem(res, 400, "bad-request", "Bad request",
                                               "the request body could not be read");
                         }
@@ -192,6 +200,13 @@ void Router::register_route(httplib::Server& server, const Compiled& c) const {
 
 void Router::install(httplib::Server& server) const {
   for (const Compiled& c : routes_) register_route(server, c);
+  // OPTIONS: 204 with Allow on a path some route serves, 404 elsewhere.
+  server.Options(".*", [this](const httplib::Request& req, httplib::Response& res) {
+    const std::string allow = allowed_methods(req.path);
+    if (allow.empty()) return send_not_found(res, "no such resource: " + req.path);
+    res.set_header("Allow", allow);
+    res.status = 204;
+  });
   // Anything else: 405 on a path some route serves, 404 elsewhere.
   for (Method m : all_methods) {
     (server.*plain_registrar(m))(".*", [this](const httplib::Request& req, httplib::Response& res) {

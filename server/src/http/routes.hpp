@@ -61,15 +61,16 @@ class Router {
  public:
   Router(std::vector<Route> routes, Context& context, const Authenticator& auth);
 
-  /// Registers every route, then the 404/405 fallback for every method.
+  /// Registers every route, then OPTIONS and the 404/405 fallback for every method.
   void install(httplib::Server& server) const;
 
   /// False only for paths an Access::open route serves; every other path,
   /// unknown ones too, needs the token (a client without it learns nothing).
   bool needs_token(const std::string& path) const;
 
-  /// The methods served on `path`, as for `Allow` ("GET, HEAD, DELETE");
-  /// empty when no route matches. HEAD comes with GET (httplib serves it).
+  /// The methods served on `path`, as for `Allow` ("GET, HEAD, DELETE,
+  /// OPTIONS"); empty when no route matches. HEAD comes with GET (httplib
+  /// serves it), OPTIONS with any (answered 204 with this list).
   std::string allowed_methods(const std::string& path) const;
 
  private:

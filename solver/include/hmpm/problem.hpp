@@ -105,11 +105,46 @@ struct InitialFields {
   std::array<FieldOfPosition, 6> effective_stress;
 };
 
-/// A box filled with `particles_per_cell` particles per axis per cell, at
-/// sub-cell centres, of cells of the grid that lie inside the box.
+/// A plane polygon: vertices in order (either orientation), closed
+/// implicitly; it must be simple (no two edges cross or touch) with
+/// non-zero area. In a 2D problem its coordinates are (x, y).
+struct Polygon {
+  std::vector<std::array<double, 2>> vertices;
+};
+
+/// A polygon extruded along `axis` over [from, to]. The polygon's two
+/// coordinates are the other two axes in order: axis z (2): (x, y);
+/// axis y (1): (x, z); axis x (0): (y, z). 3D only.
+struct Prism {
+  Polygon polygon;
+  int axis = 2;
+  double from = 0.0;
+  double to = 0.0;
+};
+
+/// Explicit particles: initial positions and volumes (m^3 in 3D, m^2 in 2D
+/// (per metre of thickness), m in 1D (per unit cross-section)), one each.
+struct ParticleList {
+  std::vector<Vec3> positions;
+  std::vector<double> volumes;
+};
+
+/// A body of one material filled with particles. Its shape is `box` unless
+/// `polygon` (2D), `prism` (3D) or `points` is set (at most one of them).
+/// A box is filled with `particles_per_cell` particles per axis per cell,
+/// at sub-cell centres, of the cells of the grid that lie inside the box; a
+/// polygon or prism at the sub-cell centres (of every cell) that lie inside
+/// it or on its boundary; `points` gives its particles explicitly. A
+/// particle position inside several bodies belongs to the first body that
+/// lists it: a later body loses it (problem_warnings says how many), so no
+/// place ever holds two particles. An earlier points body claims only its
+/// own positions.
 struct Body {
   int material = 0;  ///< index into Problem::materials
   Box box;
+  std::optional<Polygon> polygon;
+  std::optional<Prism> prism;
+  std::optional<ParticleList> points;
   int particles_per_cell = 2;
   InitialFields initial;
 };
@@ -117,7 +152,10 @@ struct Body {
 /// Grid nodes a boundary condition applies to.
 struct NodeSelection {
   bool all = false;
-  Box box;  ///< closed box; used when !all
+  Box box;  ///< closed box; used when !all and no polygon
+  /// 2D: the nodes inside the polygon or on its boundary (within 1e-6 of
+  /// the smallest cell size); replaces the box when set.
+  std::optional<Polygon> polygon;
 };
 
 /// Prescribed nodal velocity components and/or pore pressure.
@@ -144,7 +182,10 @@ struct Boundary {
 /// Surface load on one face of the particles inside `particles`.
 /// Force = traction * (particle volume / its initial length along the face normal).
 struct Traction {
-  Box particles;
+  Box particles;  ///< closed box of initial positions; used when no polygon
+  /// 2D: the particles whose initial position lies inside the polygon or on
+  /// its boundary (as NodeSelection::polygon); replaces the box when set.
+  std::optional<Polygon> polygon;
   int axis = 0;                         ///< face normal axis: 0 = x, 1 = y, 2 = z
   int side = +1;                        ///< +1 for "x+", -1 for "x-"
   std::array<FieldOfTime, 3> traction;  ///< Pa, per axis

@@ -84,15 +84,34 @@ std::vector<ProblemIssue> check_problem(const Problem& problem);
 /// `where` in the job-spec vocabulary and a message saying what to change.
 /// Today: materials whose fluid is so compressible that the u-p equations
 /// with Darcy's rho_f a term are near or past their stability limit
-/// (docs/verification.md). The run's RunResult::warnings repeat them.
+/// (docs/verification.md); bodies that lose particle positions to an
+/// earlier body where they overlap. The run's RunResult::warnings repeat them.
 std::vector<ProblemIssue> problem_warnings(const Problem& problem);
 
-/// Number of particles the bodies generate (cheap; no allocation per particle).
+/// Number of particles the bodies generate (lays the bodies out).
 std::int64_t count_particles(const Problem& problem);
 
 /// Initial positions of every particle, in the global numbering of the
-/// contract (bodies in order; in a body x fastest, then y, then z).
+/// contract (bodies in order; in a box, polygon or prism body x fastest,
+/// then y, then z; in a points body the given order), without the
+/// positions a body loses to an earlier one.
 std::vector<Vec3> initial_positions(const Problem& problem);
+
+/// Appends to `issues` what makes `polygon` unusable, at `where` (or an
+/// index under it): fewer than 3 vertices, a repeated vertex, zero area,
+/// edges that cross or touch. check_problem runs it on every polygon of the
+/// Problem.
+void check_polygon(const Polygon& polygon, const Location& where,
+                   std::vector<ProblemIssue>& issues);
+
+/// Whether a grid node at `x` belongs to the selection (its box, with a
+/// tolerance of 1e-9 cell sizes, or its polygon, inside or on the boundary
+/// within 1e-6 of the smallest cell size).
+bool node_selected(const Problem& problem, const NodeSelection& nodes, const Vec3& x);
+
+/// Whether a particle with initial position `x` is loaded by the traction
+/// (inside its box, or inside or on its polygon as node_selected).
+bool particle_selected(const Problem& problem, const Traction& traction, const Vec3& x);
 
 /// Index of the particle whose initial position is nearest to `x`; -1 if none.
 std::int64_t nearest_particle(const Problem& problem, const Vec3& x);
@@ -140,6 +159,34 @@ struct Series {
   std::vector<std::vector<double>> values;
 };
 
+/// The complete state of a run after `step`, as opaque bytes (the solver's
+/// versioned binary format, checkpoint.hpp): RunOptions::resume with these
+/// bytes continues the run to results bit-identical to an uninterrupted run
+/// at the same thread count.
+struct Checkpoint {
+  std::int64_t step = 0;
+  double time = 0.0;  ///< simulated time, s
+  std::string bytes;
+};
+
+/// What a checkpoint holds, read from its header and output bookkeeping.
+struct CheckpointInfo {
+  int version = 0;
+  std::int64_t step = 0;
+  double time = 0.0;  ///< simulated time, s
+  std::int64_t particles = 0;
+  int threads = 1;                     ///< solver threads of the run that wrote it
+  std::vector<double> snapshot_times;  ///< snapshots 0.. already taken, in order
+};
+
+/// Reads and checks `bytes` as a checkpoint of `problem` run with
+/// `checkpoint_key` (RunOptions::checkpoint_key): magic, version,
+/// dimension, shape function, scheme, particle count, the hash of the key
+/// and of the problem's set-up figures, and the checksum of the whole.
+/// Throws std::invalid_argument saying what does not match.
+CheckpointInfo inspect_checkpoint(const Problem& problem, const std::string& checkpoint_key,
+                                  const std::string& bytes);
+
 struct RunOptions {
   int threads = 1;  ///< solver threads; <= 0 means every core
   /// Fewer particles than this per thread and the run uses fewer threads:
@@ -150,10 +197,29 @@ struct RunOptions {
   double progress_interval_s = 0.5;
   /// Called for every snapshot as it is taken (written by the caller, not kept).
   std::function<void(const Snapshot&)> on_snapshot;
-  /// Checked once per step; when it becomes true the run stops as cancelled.
+  /// Checked once per step, and every few hundred particles during set-up
+  /// (particle generation, initial-field formulas, geostatic state); when it
+  /// becomes true the run stops as cancelled.
   const std::atomic<bool>* cancel = nullptr;
-  /// Wall-clock limit on the time loop in seconds; <= 0: none.
+  /// Wall-clock limit on the whole run, set-up included, in seconds (checked
+  /// as often as `cancel` in set-up, at each progress report in the time
+  /// loop); <= 0: none. Reaching it fails the run with a message naming it.
+  /// A resumed run counts the loop time of the runs before it.
   double wall_time_limit_s = 0.0;
+  /// Called with a checkpoint of the whole run state after the first step
+  /// that ends `checkpoint_interval_s` or more of wall time after the start
+  /// or the last checkpoint (<= 0: never), and once more when the run is
+  /// cancelled after steps the last checkpoint does not hold. The bytes are
+  /// the caller's to store; the buffer is reused by the next call.
+  std::function<void(const Checkpoint&)> on_checkpoint;
+  double checkpoint_interval_s = 60.0;
+  /// Names the job a checkpoint belongs to (e.g. its spec text): its hash is
+  /// in every checkpoint, and a checkpoint is resumed only with the same key.
+  std::string checkpoint_key;
+  /// Checkpoint bytes to continue from (from on_checkpoint of an earlier run
+  /// of the same problem and key); null: start at t = 0. A checkpoint that
+  /// does not belong to the problem makes run() throw std::invalid_argument.
+  const std::string* resume = nullptr;
 };
 
 enum class RunStatus { successful, failed, cancelled };
@@ -168,7 +234,7 @@ struct RunResult {
   double dt = 0.0;
   std::int64_t particles = 0;
   std::int64_t nodes = 0;
-  double solve_seconds = 0.0;  ///< wall time of the time loop only
+  double solve_seconds = 0.0;  ///< wall time of the time loop only (all runs, when resumed)
   double particle_steps_per_second = 0.0;
   std::int64_t state_bytes = 0;     ///< particle + grid state in memory
   int threads = 1;                  ///< solver threads actually used

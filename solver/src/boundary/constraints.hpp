@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "hmpm/problem.hpp"
+#include "hmpm/run.hpp"
 #include "state/grid.hpp"
 
 namespace hmpm {
@@ -63,13 +64,11 @@ struct Constraints {
 namespace detail {
 
 template <int Dim>
-bool node_in_box(const GridState<Dim>& grid, std::int64_t i, const Box& box) {
+Vec3 node_position3(const GridState<Dim>& grid, std::int64_t i) {
   const VecD<Dim> xn = grid.node_position(i);
-  for (int a = 0; a < Dim; ++a) {
-    const double tol = 1e-9 * grid.h[a];
-    if (xn[a] < box.min[a] - tol || xn[a] > box.max[a] + tol) return false;
-  }
-  return true;
+  Vec3 x{0.0, 0.0, 0.0};
+  for (int a = 0; a < Dim; ++a) x[a] = xn[a];
+  return x;
 }
 
 }  // namespace detail
@@ -84,7 +83,7 @@ Constraints compile_constraints(const Problem& problem, const GridState<Dim>& gr
   for (const Boundary& b : problem.boundaries) {
     std::vector<std::int64_t> nodes;
     for (std::int64_t i = 0; i < grid.count; ++i)
-      if (b.nodes.all || detail::node_in_box(grid, i, b.nodes.box)) nodes.push_back(i);
+      if (node_selected(problem, b.nodes, detail::node_position3(grid, i))) nodes.push_back(i);
     if (b.has_velocity) {
       VelocityConstraint vc;
       vc.nodes = nodes;
@@ -99,8 +98,9 @@ Constraints compile_constraints(const Problem& problem, const GridState<Dim>& gr
         vc.stuck.assign(vc.nodes.size(), 0);
         const int n = vc.normal;
         const double tol = 1e-9 * grid.h[n];
-        if (!b.nodes.all && b.nodes.box.max[n] <= grid.origin[n] + tol) vc.inward = 1;
-        if (!b.nodes.all && b.nodes.box.min[n] >= grid_max[n] - tol) vc.inward = -1;
+        const bool by_box = !b.nodes.all && !b.nodes.polygon;  // a polygon wall: either side
+        if (by_box && b.nodes.box.max[n] <= grid.origin[n] + tol) vc.inward = 1;
+        if (by_box && b.nodes.box.min[n] >= grid_max[n] - tol) vc.inward = -1;
       }
       c.velocity.push_back(std::move(vc));
     }

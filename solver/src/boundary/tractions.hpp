@@ -1,7 +1,7 @@
 // boundary/tractions.hpp — surface loads on particle faces (internal).
 //
 // A Traction of the Problem loads one face of the particles whose initial
-// position lies in its box. Compiled once at set-up (compile_tractions);
+// position lies in its box or polygon. Compiled once at set-up (compile_tractions);
 // each step the load is mapped to the nodes at the loaded face of each
 // particle, with the face area following the particle's volume change
 // (apply_tractions).
@@ -43,11 +43,7 @@ std::vector<TractionLoad> compile_tractions(const Problem& problem,
     load.axis = t.axis;
     load.side = t.side;
     for (std::size_t p = 0; p < x0.size(); ++p) {
-      bool inside = true;
-      for (int a = 0; a < Dim; ++a)
-        inside = inside && x0[p][a] >= t.particles.min[a] - 1e-12 &&
-                 x0[p][a] <= t.particles.max[a] + 1e-12;
-      if (!inside) continue;
+      if (!particle_selected(problem, t, x0[p])) continue;
       load.particles.push_back(static_cast<std::int64_t>(p));
       // Initial length along the face normal: the cell size over the body's
       // particles per cell, recovered from the initial volume per axis.

@@ -21,9 +21,11 @@ namespace hmpm {
 std::vector<bool> materials_with_particles(const Problem& problem) {
   std::vector<bool> used(problem.materials.size(), false);
   bool any = false;
-  for (const Body& body : problem.bodies) {
+  const std::vector<BodyLayout> layouts = body_layouts(problem);
+  for (std::size_t b = 0; b < problem.bodies.size(); ++b) {
+    const Body& body = problem.bodies[b];
     if (body.material < 0 || body.material >= static_cast<int>(used.size())) continue;
-    if (body.particles_per_cell < 1 || body_layout(problem, body).count == 0) continue;
+    if (body.particles_per_cell < 1 || layouts[b].count == 0) continue;
     used[static_cast<std::size_t>(body.material)] = true;
     any = true;
   }

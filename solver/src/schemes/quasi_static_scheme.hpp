@@ -160,6 +160,29 @@ class QuasiStaticScheme final : public TimeScheme {
     result.iterations.worst_residuals = worst_;
   }
 
+  /// The step plan (nominal length; growth and limits come from the
+  /// problem), the counters and the worst step's residuals. Between steps
+  /// nothing else lasts: each step prepares its grid and system afresh.
+  void save(checkpoint::Writer& w) const override {
+    w.pod(nominal_);
+    w.pod(nonlinear_);
+    w.pod(cutbacks_);
+    w.pod(max_nonlinear_);
+    w.array(worst_);
+    w.pod(system_.linear_iterations);
+    w.pod(system_.solves);
+  }
+  void load(checkpoint::Reader& r) override {
+    nominal_ = r.pod<double>();
+    nonlinear_ = r.pod<std::int64_t>();
+    cutbacks_ = r.pod<std::int64_t>();
+    max_nonlinear_ = r.pod<int>();
+    r.array(worst_, -1, "residual history");
+    system_.linear_iterations = r.pod<std::int64_t>();
+    system_.solves = r.pod<std::int64_t>();
+    prepared_ = false;
+  }
+
  private:
   // ------------------------------------------------------------ the step's grid
   /// Stencils, active nodes, the projection of the particle pressures, the

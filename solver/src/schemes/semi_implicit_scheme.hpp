@@ -110,6 +110,18 @@ class SemiImplicitScheme final : public TimeScheme {
     result.iterations.linear += linear_iterations_;
   }
 
+  /// The last increment (the iterative solver's initial guess) and the counters.
+  void save(checkpoint::Writer& w) const override {
+    w.array(last_dp_);
+    w.pod(solves_);
+    w.pod(linear_iterations_);
+  }
+  void load(checkpoint::Reader& r) override {
+    r.array(last_dp_, static_cast<std::int64_t>(last_dp_.size()), "pressure increment");
+    solves_ = r.pod<std::int64_t>();
+    linear_iterations_ = r.pod<std::int64_t>();
+  }
+
  private:
   bool set_local_damping(double t) {
     const Problem& problem = sim_.problem_;

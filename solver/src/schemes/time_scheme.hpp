@@ -22,6 +22,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "checkpoint.hpp"
 #include "hmpm/problem.hpp"
 #include "hmpm/run.hpp"
 
@@ -42,6 +43,10 @@ class TimeScheme {
   virtual void step(double t, double dt) = 0;
   /// Adds the scheme's counters (iterations, cut-backs) to the result.
   virtual void report(RunResult& /*result*/) const {}
+  /// Writes the state the scheme carries from one step to the next (between
+  /// steps; checkpoint.hpp), and reads it back into a fresh scheme.
+  virtual void save(checkpoint::Writer& /*w*/) const {}
+  virtual void load(checkpoint::Reader& /*r*/) {}
 };
 
 /// The rules of a scheme that need only the Problem.

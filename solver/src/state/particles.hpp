@@ -52,6 +52,28 @@ struct ParticleState {
 
   std::size_t size() const { return x.size(); }
 
+  /// f(array) for every array above, in a fixed order (the checkpoint
+  /// writes and reads the whole particle state through it: a new array
+  /// belongs here too).
+  template <class F>
+  void for_each_array(F&& f) {
+    f(x);
+    f(x0);
+    f(v);
+    f(mass);
+    f(volume);
+    f(stress);
+    f(strain);
+    f(material);
+    f(cell);
+    f(half_length);
+    f(pressure);
+    f(pressure_out);
+    f(porosity);
+    f(darcy);
+    for (std::vector<double>& k : internal) f(k);
+  }
+
   void resize(std::size_t n, bool fluid, bool gimp, int state_variables = 0) {
     internal.assign(static_cast<std::size_t>(state_variables), std::vector<double>(n, 0.0));
     x.resize(n);

@@ -42,6 +42,12 @@ struct Limits {
   std::int64_t max_body_bytes = std::int64_t{16} << 20;   ///< size of the spec text
   int max_json_depth = 64;
   std::int64_t max_series_particles = 10'000;  ///< entries of output.series.particles
+  /// Formulas (strings in x, y, z or t) in one spec, and their characters
+  /// in all: compiling and checking them is validation work done before a
+  /// job is accepted, so it is bounded (each formula is at most 4096
+  /// characters besides).
+  std::int64_t max_formulas = 1000;
+  std::int64_t max_formula_characters = 65'536;
 };
 
 /// The machine speed the wall-time estimate scales with (docs/performance.md,
@@ -78,7 +84,12 @@ struct CostEstimate {
   std::int64_t steps = 0;
   double dt = 0.0;
   std::int64_t particle_steps = 0;
-  std::int64_t memory_bytes = 0;  ///< solver state estimate
+  /// Peak memory of the run: particle and grid state, the grid buffers of
+  /// every solver thread (Calibration::threads), the series kept in memory
+  /// until the end, one snapshot's arrays and set-up's temporaries
+  /// (docs/performance.md, "Memory estimate").
+  std::int64_t memory_bytes = 0;
+  int threads = 1;                ///< solver threads the estimate assumes
   std::int64_t output_bytes = 0;  ///< result files estimate
   std::int64_t series_rows = 0;
   std::int64_t snapshots = 0;
@@ -112,12 +123,19 @@ ParseResult parse_job(std::string_view json_text, const Limits& limits = {});
 struct JobOutcome {
   hmpm::RunResult run;
   std::vector<std::string> files;  ///< names relative to the output directory
+  /// Why a result file could not be written (disk full, ...); empty if all were.
+  std::string write_error;
 };
 
 /// Runs `job` and writes every result file into `out_dir` (created if needed):
 /// summary.json always (also on failure), series.json and series.csv when a
 /// series was requested, snapshots.pvd and snapshot_NNNN.vtu when snapshots
-/// were requested. Throws std::runtime_error only when files cannot be written.
+/// were requested. When a file cannot be written, the run fails
+/// (`write_error`, run.status failed), every other result file it wrote is
+/// removed (a full disk is not left fuller, and no file is left that the
+/// list does not name) and summary.json says why; `files` then lists
+/// summary.json alone, or nothing if even that could not be written. Throws
+/// std::runtime_error only when `out_dir` cannot be created.
 JobOutcome run_job(const ParsedJob& job, const std::filesystem::path& out_dir,
                    const hmpm::RunOptions& options = {});
 

@@ -19,9 +19,13 @@ struct ParsedOptions {
 };
 
 /// Parses `args` (without the program name). `env_token` is HMPM_TOKEN (may
-/// be null); --token wins over it.
+/// be null); --token or --token-file wins over it; an empty token in any of
+/// them is an error, as is a non-loopback --host without a token unless
+/// --allow-no-token is given.
 ParsedOptions parse_options(const std::vector<std::string>& args, const char* env_token);
 
+/// True for localhost, 127.0.0.0/8 and ::1.
+bool is_loopback_host(const std::string& host);
 /// The --help text.
 std::string usage();
 

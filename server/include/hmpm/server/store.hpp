@@ -13,13 +13,14 @@
 // jobs of another live process.
 //
 // Backends: the SQLite store (`open_sqlite_store`, one process per file,
-// server/src/store/sqlite/); a shared PostgreSQL store can sit beside it.
+// server/src/store/sqlite/) and the PostgreSQL store (`open_postgres_store`,
+// any number of processes on one database, server/src/store/postgres/).
 // Every backend passes the contract suite in tests/server/store_contract.hpp.
 //
 // Domain outcomes (unknown job, queue full, idempotency conflict, lost claim)
 // are values; only a failing database (disk full, corrupt file, newer schema,
 // a file another process holds) throws StoreFailure, which the HTTP edge
-// turns into a 500 and start-up into exit 1.
+// turns into 503 or 507 with Retry-After and start-up into exit 1.
 #pragma once
 
 #include <chrono>
@@ -43,10 +44,17 @@ namespace hmpm::server {
 /// to age jobs without sleeping.
 using WallClock = std::function<std::chrono::system_clock::time_point()>;
 
-/// A database failure the service cannot recover from by itself.
+/// A database failure the service cannot recover from by itself. `no_space`:
+/// the write failed for want of space (disk full, quota, file-size limit),
+/// which the HTTP edge answers 507 instead of 503.
 class StoreFailure : public std::runtime_error {
  public:
-  using std::runtime_error::runtime_error;
+  explicit StoreFailure(const std::string& what, bool no_space = false)
+      : std::runtime_error(what), no_space_(no_space) {}
+  bool no_space() const { return no_space_; }
+
+ private:
+  bool no_space_ = false;
 };
 
 /// What parse_job estimated a job will cost, kept for the status document.
@@ -116,6 +124,10 @@ struct SubmitResult {
   JobRecord job;
 };
 
+/// recover(): how many starts, in units of max_attempts, a job may have
+/// without a charged crash before it fails anyway.
+inline constexpr int uncharged_start_factor = 3;
+
 /// What start-up recovery did with jobs an earlier process left `running`.
 struct RecoveryReport {
   std::vector<std::string> requeued;
@@ -159,11 +171,23 @@ struct JobEnd {
   double run_seconds = 0.0;
 };
 
+/// A running job's last checkpoint: the solver state after `step`, in
+/// `<data-dir>/<job id>/<file>`.
+struct CheckpointRecord {
+  std::string file;
+  std::int64_t step = 0;
+  double time = 0.0;  ///< simulated time, s
+  std::int64_t size = 0;
+  std::string sha256;
+  std::string written;  ///< RFC 3339 UTC
+};
+
 class JobStore {
  public:
   virtual ~JobStore() = default;
 
-  /// Reads the store (a cheap probe for /health); throws StoreFailure if it cannot.
+  /// Reads the store and, at most about once a second, writes to it (a
+  /// probe for /health); throws StoreFailure if either fails.
   virtual void probe() = 0;
 
   /// Stores a new accepted job unless the queue holds `max_queue` accepted
@@ -221,10 +245,17 @@ class JobStore {
 
   virtual std::vector<ResultFile> results(const std::string& id) = 0;
 
-  /// Recovery: every running job whose lease has lapsed goes back to
-  /// `accepted` while attempts < max_attempts, else to `failed` with the
-  /// reason. Jobs with a live lease are left alone, whoever owns them.
-  virtual RecoveryReport recover(int max_attempts) = 0;
+  /// Recovery: every running job whose lease has lapsed (its server died)
+  /// goes back to `accepted`, or to `failed` with the reason. The crash is
+  /// charged to the job only if its attempt had been running for at least
+  /// `charge_after_s` (claim to its last lease renewal or progress write):
+  /// a job claimed just before an unrelated crash is innocent. A job fails
+  /// once max_attempts crashes were charged to it, or, as a backstop against
+  /// a job that kills its server within charge_after_s of every start, once
+  /// it was started uncharged_start_factor * max_attempts times. Queued jobs
+  /// are never charged. Jobs with a live lease are left alone, whoever owns
+  /// them.
+  virtual RecoveryReport recover(int max_attempts, double charge_after_s) = 0;
 
   virtual StatusCounts count_by_status() = 0;
 
@@ -235,6 +266,14 @@ class JobStore {
   /// purged, however old. A purged id is unknown from then on (find: nullopt).
   virtual std::vector<std::string> purge_ended(
       std::chrono::system_clock::time_point ended_before) = 0;
+
+  /// Records the checkpoint a running job just wrote (its file under the
+  /// job's data folder, named by the claim's token so a stale writer never
+  /// overwrites the current one). held: recorded; dismissed/lost as for
+  /// update_progress (the file is then the caller's to remove).
+  virtual ClaimState record_checkpoint(const Claim& claim, const CheckpointRecord& checkpoint) = 0;
+  /// The job's last recorded checkpoint, if any (cleared when the job ends).
+  virtual std::optional<CheckpointRecord> checkpoint(const std::string& id) = 0;
 };
 
 /// Opens (creating if needed) the SQLite database at `db_path` for this
@@ -246,5 +285,18 @@ class JobStore {
 /// `clock` is the store's time (empty: the system clock).
 std::unique_ptr<JobStore> open_sqlite_store(const std::filesystem::path& db_path,
                                             WallClock clock = {});
+
+/// True when `db` names a PostgreSQL database (a libpq URI: postgresql://
+/// or postgres://) rather than a SQLite file.
+bool is_postgres_uri(std::string_view db);
+
+/// Connects to the PostgreSQL database of the libpq URI `uri` and migrates
+/// it to the current schema (concurrent servers migrate one at a time).
+/// Any number of processes may share the database: each claims with its own
+/// Claimant, and recover() takes only the jobs whose lease has lapsed.
+/// Timestamps and leases come from `clock` (empty: the system clock), so
+/// the servers' clocks must agree to well under a lease (NTP). Throws
+/// StoreFailure when it cannot connect or the schema is newer than this build.
+std::unique_ptr<JobStore> open_postgres_store(const std::string& uri, WallClock clock = {});
 
 }  // namespace hmpm::server

@@ -1,14 +1,64 @@
 // connection.cpp — see connection.hpp.
 #include "connection.hpp"
 
+#include <sys/resource.h>
+
+#include <cerrno>
+#include <cstdint>
+#include <cstring>
+#include <filesystem>
+#include <string>
 #include <utility>
 
 #include "hmpm/server/store.hpp"
 
 namespace hmpm::server::sqlite {
 
+namespace {
+
+// The operating system's error behind the last failure of `db`, 0 if it was
+// not an I/O failure (SQLite keeps the errno of its last failed system call).
+int system_error(sqlite3* db) {
+  const int code = db ? sqlite3_errcode(db) : SQLITE_NOMEM;
+  return code == SQLITE_IOERR || code == SQLITE_FULL || code == SQLITE_CANTOPEN
+             ? sqlite3_system_errno(db)
+             : 0;
+}
+
+// Whether a file of the database has reached the process's file-size limit
+// (RLIMIT_FSIZE), or its file system has less than 1 MiB left.
+bool files_at_their_limit(sqlite3* db) {
+  const char* name = sqlite3_db_filename(db, "main");
+  if (!name || !*name) return false;
+  const std::filesystem::path path(name);
+  std::error_code ec;
+  const auto space = std::filesystem::space(path.parent_path(), ec);
+  if (!ec && space.available < (std::uintmax_t{1} << 20)) return true;
+  rlimit limit{};
+  if (::getrlimit(RLIMIT_FSIZE, &limit) != 0 || limit.rlim_cur == RLIM_INFINITY) return false;
+  for (const std::string suffix : {"", "-wal", "-shm"}) {
+    const auto size = std::filesystem::file_size(path.string() + suffix, ec);
+    if (!ec && size >= limit.rlim_cur) return true;
+  }
+  return false;
+}
+
+// Whether the last failure of `db` was for want of space: SQLITE_FULL, or an
+// I/O error from a full disk, a quota or a file-size limit. SQLite's errno
+// of an I/O error is not always the write's, so the files are looked at too.
+bool out_of_space(sqlite3* db) {
+  if (!db) return false;
+  const int error = system_error(db);
+  return sqlite3_errcode(db) == SQLITE_FULL || error == ENOSPC || error == EFBIG ||
+         error == EDQUOT || (sqlite3_errcode(db) == SQLITE_IOERR && files_at_their_limit(db));
+}
+
+}  // namespace
+
 void fail(sqlite3* db, const std::string& what) {
-  throw StoreFailure(what + ": " + (db ? sqlite3_errmsg(db) : "out of memory"));
+  std::string message = what + ": " + (db ? sqlite3_errmsg(db) : "out of memory");
+  if (const int error = system_error(db)) message += std::string(" (") + std::strerror(error) + ")";
+  throw StoreFailure(message, out_of_space(db));
 }
 
 void exec(sqlite3* db, const char* sql) {
@@ -16,7 +66,7 @@ void exec(sqlite3* db, const char* sql) {
   if (sqlite3_exec(db, sql, nullptr, nullptr, &error) != SQLITE_OK) {
     const std::string message = error ? error : "unknown error";
     sqlite3_free(error);
-    throw StoreFailure(std::string("sqlite: ") + message);
+    throw StoreFailure(std::string("sqlite: ") + message, out_of_space(db));
   }
 }
 

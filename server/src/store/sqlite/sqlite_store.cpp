@@ -7,6 +7,7 @@
 #include "sqlite_store.hpp"
 
 #include <chrono>
+#include <cstdio>
 #include <utility>
 
 #include "clock.hpp"
@@ -84,6 +85,13 @@ void clear_results(sqlite3* db, const std::string& id) {
   clear.step();
 }
 
+// A job that ends forgets its checkpoint (the worker removes the file).
+void clear_checkpoint(sqlite3* db, const std::string& id) {
+  Statement clear(db, "DELETE FROM checkpoints WHERE job_id = ?1");
+  clear.bind(1, id);
+  clear.step();
+}
+
 void insert_results(sqlite3* db, const std::string& id, const std::vector<ResultFile>& files) {
   for (const ResultFile& f : files) {
     Statement s(
@@ -92,6 +100,13 @@ void insert_results(sqlite3* db, const std::string& id, const std::vector<Result
     s.bind(1, id).bind(2, f.name).bind(3, f.size).bind(4, f.sha256).bind(5, f.media_type);
     s.step();
   }
+}
+
+// "30 s", "1.5 s".
+std::string short_duration(double seconds) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%g s", seconds);
+  return text;
 }
 
 }  // namespace
@@ -116,12 +131,56 @@ std::int64_t SqliteStore::lease_until(const Claimant& who) const {
   return now_ms() + static_cast<std::int64_t>(who.lease_s * 1000.0);
 }
 
+namespace {
+
+// What to do about a database file that cannot be used as it is.
+constexpr const char* damaged_advice =
+    "; restore it from a backup, or move it away to start with an empty queue (its jobs are "
+    "then lost)";
+
+// A file that exists but is empty would be taken by SQLite for a new
+// database: an emptied file (a failed copy, a full disk) must not become an
+// empty queue quietly.
+void refuse_empty_file(const std::filesystem::path& db_path) {
+  std::error_code ec;
+  if (std::filesystem::exists(db_path, ec) && std::filesystem::file_size(db_path, ec) == 0 && !ec)
+    throw StoreFailure("database " + db_path.string() +
+                       " is an empty file (0 bytes), not an hmpm database" + damaged_advice);
+}
+
+// PRAGMA quick_check over the whole file (every page, index and row
+// format; O(file size), a second or so per hundred MiB).
+void check_integrity(sqlite3* db, const std::filesystem::path& db_path) {
+  Statement s(db, "PRAGMA quick_check(5)");
+  std::string found;
+  while (s.step()) {
+    const std::string row = s.text(0);
+    if (row == "ok") continue;
+    found += (found.empty() ? "" : "; ") + row;
+  }
+  if (!found.empty())
+    throw StoreFailure("database " + db_path.string() + " is damaged (integrity check: " + found +
+                       ")" + damaged_advice);
+}
+
+}  // namespace
+
 SqliteStore::SqliteStore(const std::filesystem::path& db_path, WallClock clock)
     : clock_(std::move(clock)),
       lock_(ProcessLock::hold(lock_path_for(db_path), "database " + db_path.string())),
       pool_(db_path) {
-  auto connection = pool_.lease();
-  sqlite3* db = connection.get();
+  refuse_empty_file(db_path);
+  std::optional<Connection> connection;
+  try {
+    connection.emplace(pool_.lease());
+    check_integrity(connection->get(), db_path);
+  } catch (const StoreFailure& e) {
+    const std::string what = e.what();
+    if (what.rfind("database ", 0) == 0) throw;
+    throw StoreFailure("database " + db_path.string() + " cannot be opened (" + what + ")" +
+                       damaged_advice);
+  }
+  sqlite3* db = connection->get();
   migrate(db);
   // The lock is ours, so no other process is running anything: every
   // earlier claim is void and recover() may requeue its job.
@@ -132,8 +191,42 @@ SqliteStore::SqliteStore(const std::filesystem::path& db_path, WallClock clock)
 }
 
 void SqliteStore::probe() {
-  auto db = pool_.lease();
-  recorded_version(db.get());
+  auto connection = pool_.lease();
+  sqlite3* db = connection.get();
+  try {
+    recorded_version(db);
+  } catch (const StoreFailure& e) {
+    throw StoreFailure(std::string("the database cannot be read: ") + e.what(), e.no_space());
+  }
+  // The write: at most once a second (health checks may come far more
+  // often); in between, the last write's outcome stands.
+  const auto now = std::chrono::steady_clock::now();
+  {
+    std::lock_guard<std::mutex> lock(probe_mutex_);
+    if (now - last_write_probe_ < std::chrono::seconds(1)) {
+      if (!write_probe_error_.empty()) throw StoreFailure(write_probe_error_, write_probe_full_);
+      return;
+    }
+    last_write_probe_ = now;
+  }
+  std::string error;
+  bool full = false;
+  try {
+    WriteTransaction tx(db);
+    Statement s(db,
+                "INSERT INTO store_probe (id, written) VALUES (1, ?1) "
+                "ON CONFLICT (id) DO UPDATE SET written = excluded.written");
+    s.bind(1, now_text());
+    s.step();
+    tx.commit();
+  } catch (const StoreFailure& e) {
+    error = std::string("the database cannot be written: ") + e.what();
+    full = e.no_space();
+  }
+  std::lock_guard<std::mutex> lock(probe_mutex_);
+  write_probe_error_ = error;
+  write_probe_full_ = full;
+  if (!error.empty()) throw StoreFailure(error, full);
 }
 
 SubmitResult SqliteStore::submit(const NewJob& job, std::int64_t max_queue) {
@@ -227,8 +320,9 @@ std::optional<JobRecord> SqliteStore::claim_next(const Claimant& who) {
   Statement s(db, "UPDATE jobs SET status = " + sql_name(JobStatus::running) +
                       ", progress = 0, message = 'running', started = ?1, finished = NULL, "
                       "updated = ?1, attempts = attempts + 1, owner = ?3, "
-                      "lease_token = lease_token + 1, lease_expires_ms = ?4 WHERE id = ?2");
-  s.bind(1, now).bind(2, id).bind(3, who.instance).bind(4, lease_until(who));
+                      "lease_token = lease_token + 1, lease_expires_ms = ?4, claimed_ms = ?5, "
+                      "alive_ms = ?5 WHERE id = ?2");
+  s.bind(1, now).bind(2, id).bind(3, who.instance).bind(4, lease_until(who)).bind(5, now_ms());
   s.step();
   auto job = select_job(db, id);
   tx.commit();
@@ -239,9 +333,10 @@ std::int64_t SqliteStore::renew_leases(const Claimant& who) {
   auto connection = pool_.lease();
   sqlite3* db = connection.get();
   WriteTransaction tx(db);
-  Statement s(db, "UPDATE jobs SET lease_expires_ms = ?1 WHERE owner = ?2 AND status = " +
-                      sql_name(JobStatus::running));
-  s.bind(1, lease_until(who)).bind(2, who.instance);
+  Statement s(
+      db, "UPDATE jobs SET lease_expires_ms = ?1, alive_ms = ?3 WHERE owner = ?2 AND status = " +
+              sql_name(JobStatus::running));
+  s.bind(1, lease_until(who)).bind(2, who.instance).bind(3, now_ms());
   s.step();
   const std::int64_t renewed = sqlite3_changes(db);
   tx.commit();
@@ -252,9 +347,9 @@ ClaimState SqliteStore::update_progress(const Claim& claim, double percent) {
   auto connection = pool_.lease();
   sqlite3* db = connection.get();
   WriteTransaction tx(db);
-  Statement s(db, "UPDATE jobs SET progress = ?4, updated = ?5 WHERE " + claim_held);
+  Statement s(db, "UPDATE jobs SET progress = ?4, updated = ?5, alive_ms = ?6 WHERE " + claim_held);
   bind_claim(s, claim);
-  s.bind(4, percent).bind(5, now_text());
+  s.bind(4, percent).bind(5, now_text()).bind(6, now_ms());
   s.step();
   const ClaimState state = sqlite3_changes(db) == 1 ? ClaimState::held : claim_state(db, claim);
   tx.commit();
@@ -280,6 +375,7 @@ ClaimState SqliteStore::finish(const Claim& claim, const JobEnd& end) {
   }
   clear_results(db, claim.job_id);
   insert_results(db, claim.job_id, end.files);
+  clear_checkpoint(db, claim.job_id);
   tx.commit();
   return ClaimState::held;
 }
@@ -312,6 +408,7 @@ std::optional<JobRecord> SqliteStore::cancel(const std::string& id) {
                       "WHERE id = ?2");
   s.bind(1, now_text()).bind(2, id);
   s.step();
+  clear_checkpoint(db, id);
   tx.commit();
   return before;
 }
@@ -332,6 +429,7 @@ std::optional<JobRecord> SqliteStore::dismiss(const std::string& id) {
     s.step();
   }
   clear_results(db, id);
+  clear_checkpoint(db, id);
   tx.commit();
   return before;
 }
@@ -368,38 +466,61 @@ std::vector<ResultFile> SqliteStore::results(const std::string& id) {
   return out;
 }
 
-RecoveryReport SqliteStore::recover(int max_attempts) {
+RecoveryReport SqliteStore::recover(int max_attempts, double charge_after_s) {
   auto connection = pool_.lease();
   sqlite3* db = connection.get();
   WriteTransaction tx(db);
-  std::vector<std::pair<std::string, int>> lapsed;
+  struct Lapsed {
+    std::string id;
+    int attempts = 0;
+    int charged = 0;
+    double ran_s = 0.0;  ///< claim to last proof of life
+  };
+  std::vector<Lapsed> lapsed;
   {
-    Statement s(db, "SELECT id, attempts FROM jobs WHERE status = " + sql_name(JobStatus::running) +
-                        " AND lease_expires_ms <= ?1 ORDER BY seq");
+    Statement s(db,
+                "SELECT id, attempts, charged, alive_ms - claimed_ms FROM jobs WHERE status = " +
+                    sql_name(JobStatus::running) + " AND lease_expires_ms <= ?1 ORDER BY seq");
     s.bind(1, now_ms());
-    while (s.step()) lapsed.emplace_back(s.text(0), static_cast<int>(s.integer(1)));
+    while (s.step()) {
+      lapsed.push_back({s.text(0), static_cast<int>(s.integer(1)), static_cast<int>(s.integer(2)),
+                        static_cast<double>(s.integer(3)) / 1000.0});
+    }
   }
   RecoveryReport report;
   const std::string now = now_text();
-  for (const auto& [id, attempts] : lapsed) {
-    if (attempts < max_attempts) {
+  for (const Lapsed& job : lapsed) {
+    // Charged only when the attempt had run long enough to be the suspect;
+    // a job claimed just before an unrelated crash is not.
+    const int charged = job.charged + (job.ran_s >= charge_after_s ? 1 : 0);
+    std::string reason;
+    if (charged >= max_attempts) {
+      reason = "the server stopped " + std::to_string(charged) +
+               " times while this job ran (each time after at least " +
+               short_duration(charge_after_s) + " of its attempt; limit " +
+               std::to_string(max_attempts) + " attempts); not retried";
+    } else if (job.attempts >= uncharged_start_factor * max_attempts) {
+      reason = "this job was started " + std::to_string(job.attempts) +
+               " times and the server stopped every time, mostly within " +
+               short_duration(charge_after_s) + " of the start (limit " +
+               std::to_string(uncharged_start_factor * max_attempts) + " starts); not retried";
+    }
+    if (reason.empty()) {
       Statement s(db,
                   "UPDATE jobs SET status = " + sql_name(JobStatus::accepted) +
-                      ", progress = 0, started = NULL, updated = ?1, "
+                      ", progress = 0, started = NULL, updated = ?1, charged = ?3, "
                       "message = 'queued again: the server stopped while it ran' WHERE id = ?2");
-      s.bind(1, now).bind(2, id);
+      s.bind(1, now).bind(2, job.id).bind(3, static_cast<std::int64_t>(charged));
       s.step();
-      report.requeued.push_back(id);
+      report.requeued.push_back(job.id);
     } else {
-      const std::string reason = "the server stopped while this job ran, " +
-                                 std::to_string(attempts) + " times (limit " +
-                                 std::to_string(max_attempts) + " attempts); not retried";
       Statement s(db, "UPDATE jobs SET status = " + sql_name(JobStatus::failed) +
-                          ", message = ?1, failure_reason = ?1, finished = ?2, updated = ?2 "
-                          "WHERE id = ?3");
-      s.bind(1, reason).bind(2, now).bind(3, id);
+                          ", message = ?1, failure_reason = ?1, finished = ?2, updated = ?2, "
+                          "charged = ?4 WHERE id = ?3");
+      s.bind(1, reason).bind(2, now).bind(3, job.id).bind(4, static_cast<std::int64_t>(charged));
       s.step();
-      report.failed.push_back(id);
+      clear_checkpoint(db, job.id);
+      report.failed.push_back(job.id);
     }
   }
   tx.commit();
@@ -433,12 +554,46 @@ std::vector<std::string> SqliteStore::purge_ended(
     s.bind(1, cutoff);
     while (s.step()) ids.push_back(s.text(0));
   }
-  for (const std::string& id : ids) clear_results(db, id);
+  for (const std::string& id : ids) {
+    clear_results(db, id);
+    clear_checkpoint(db, id);
+  }
   Statement s(db, "DELETE FROM jobs WHERE " + ended);
   s.bind(1, cutoff);
   s.step();
   tx.commit();
   return ids;
+}
+
+ClaimState SqliteStore::record_checkpoint(const Claim& claim, const CheckpointRecord& checkpoint) {
+  auto connection = pool_.lease();
+  sqlite3* db = connection.get();
+  WriteTransaction tx(db);
+  {
+    Statement s(db, "UPDATE jobs SET updated = ?4 WHERE " + claim_held);
+    bind_claim(s, claim);
+    s.bind(4, now_text());
+    s.step();
+    if (sqlite3_changes(db) != 1) return claim_state(db, claim);
+  }
+  Statement s(db,
+              "INSERT OR REPLACE INTO checkpoints (job_id, file, step, time, size, sha256, "
+              "written) VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7)");
+  s.bind(1, claim.job_id).bind(2, checkpoint.file).bind(3, checkpoint.step);
+  s.bind(4, checkpoint.time).bind(5, checkpoint.size).bind(6, checkpoint.sha256);
+  s.bind(7, checkpoint.written.empty() ? now_text() : checkpoint.written);
+  s.step();
+  tx.commit();
+  return ClaimState::held;
+}
+
+std::optional<CheckpointRecord> SqliteStore::checkpoint(const std::string& id) {
+  auto db = pool_.lease();
+  Statement s(db.get(),
+              "SELECT file, step, time, size, sha256, written FROM checkpoints WHERE job_id = ?1");
+  s.bind(1, id);
+  if (!s.step()) return std::nullopt;
+  return CheckpointRecord{s.text(0), s.integer(1), s.real(2), s.integer(3), s.text(4), s.text(5)};
 }
 
 }  // namespace hmpm::server::sqlite

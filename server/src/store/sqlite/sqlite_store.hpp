@@ -8,8 +8,11 @@
 // earlier process are void and end as soon as the lock is ours.
 #pragma once
 
+#include <chrono>
 #include <filesystem>
+#include <mutex>
 #include <optional>
+#include <string>
 
 #include "connection.hpp"
 #include "hmpm/server/store.hpp"
@@ -38,9 +41,11 @@ class SqliteStore final : public JobStore {
   ClaimState keep_results(const Claim& claim, const std::vector<ResultFile>& files,
                           double run_seconds) override;
   std::vector<ResultFile> results(const std::string& id) override;
-  RecoveryReport recover(int max_attempts) override;
+  RecoveryReport recover(int max_attempts, double charge_after_s) override;
   StatusCounts count_by_status() override;
   std::vector<std::string> purge_ended(std::chrono::system_clock::time_point ended_before) override;
+  ClaimState record_checkpoint(const Claim& claim, const CheckpointRecord& checkpoint) override;
+  std::optional<CheckpointRecord> checkpoint(const std::string& id) override;
 
  private:
   std::chrono::system_clock::time_point now() const;
@@ -51,6 +56,11 @@ class SqliteStore final : public JobStore {
   WallClock clock_;
   ProcessLock lock_;  ///< taken first, released last
   ConnectionPool pool_;
+  // probe(): when the last write probe ran and what it found ("" = written).
+  std::mutex probe_mutex_;
+  std::chrono::steady_clock::time_point last_write_probe_{};
+  std::string write_probe_error_;
+  bool write_probe_full_ = false;
 };
 
 /// The lock file of the database at `db_path`: `<db_path>.lock`.
