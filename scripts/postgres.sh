@@ -29,7 +29,9 @@ as_owner() {
   if [ "$(id -u)" -eq 0 ]; then
     local user=postgres
     id "$user" >/dev/null 2>&1 || user=nobody
-    setpriv --reuid="$user" --regid="$(id -g "$user")" --clear-groups -- "$@"
+    # From /: the owner may not be allowed into the caller's folder (pg_ctl
+    # would say "could not change directory ... Permission denied").
+    (cd / && setpriv --reuid="$user" --regid="$(id -g "$user")" --clear-groups -- "$@")
   else
     "$@"
   fi

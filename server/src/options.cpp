@@ -289,6 +289,15 @@ ParsedOptions parse_options(const std::vector<std::string>& args, const char* en
     result.error = "--db PATH is required";
     return result;
   }
+  if (const std::string db = config.db_path.string();
+      !is_postgres_uri(db) && db.find("://") != std::string::npos) {
+    // Not a file name anybody means: it would become a SQLite file in a
+    // folder named after the scheme ("postgresql:/user@host/db").
+    result.error = "--db " + db +
+                   " is a URI of a kind hmpm-server does not know: give a "
+                   "postgresql://USER@HOST:PORT/DBNAME URI or the path of a SQLite file";
+    return result;
+  }
   if (is_postgres_uri(config.db_path.string()) && config.data_dir.empty()) {
     result.error =
         "--data-dir DIR is required with a PostgreSQL --db (the folder every server "

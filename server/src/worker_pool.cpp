@@ -57,12 +57,21 @@ std::string short_number(double x) {
   return text;
 }
 
-// Removes everything in `dir` but the job's log (it spans every attempt).
-void remove_all_but_log(const std::filesystem::path& dir) {
+// Removes everything in `dir` but the job's log (it spans every attempt)
+// and the entry named `keep` (an attempt folder), if any.
+void remove_all_but_log(const std::filesystem::path& dir, const std::string& keep = "") {
   std::error_code ec;
   for (const auto& entry : std::filesystem::directory_iterator(dir, ec)) {
-    if (entry.path().filename() != run_log_name) std::filesystem::remove_all(entry.path(), ec);
+    const std::string name = entry.path().filename().string();
+    if (name != run_log_name && (keep.empty() || name != keep))
+      std::filesystem::remove_all(entry.path(), ec);
   }
+}
+
+// The folder, inside the job's, where the attempt of the claim with fencing
+// token `token` writes: "attempt-<token>".
+std::string attempt_name(std::int64_t token) {
+  return "attempt-" + std::to_string(token);
 }
 
 // Removes every file of `dir` that is neither the job's log nor one of
@@ -85,6 +94,23 @@ constexpr const char* checkpoint_suffix = ".hmpmck";
 
 bool is_checkpoint_file(const std::string& name) {
   return name.rfind(checkpoint_prefix, 0) == 0;
+}
+
+// Copies the result files an earlier attempt wrote in `from` (the snapshots
+// before its checkpoint) into this attempt's folder `to`: a resumed run
+// writes only what comes after the checkpoint. Copies, not links: a revived
+// earlier owner rewriting its own files must not change ours. Throws
+// std::filesystem::filesystem_error.
+void carry_over(const std::filesystem::path& from, const std::filesystem::path& to) {
+  std::filesystem::create_directories(to);
+  for (const auto& entry : std::filesystem::directory_iterator(from)) {
+    const std::string name = entry.path().filename().string();
+    if (!entry.is_regular_file() || name == run_log_name || name.rfind("checkpoint-", 0) == 0 ||
+        entry.path().extension() == ".tmp")
+      continue;
+    std::filesystem::copy_file(entry.path(), to / name,
+                               std::filesystem::copy_options::overwrite_existing);
+  }
 }
 
 // Removes the job's checkpoint files but `keep` (and any half-written one).
@@ -194,16 +220,32 @@ void log_recovery(const RecoveryReport& recovery) {
   }
 }
 
-void WorkerPool::claim_lost(const std::string& id, double seconds) {
+void WorkerPool::claim_lost(const Claim& claim, double seconds) {
   ++metrics_.claims_lost;
-  log_line({{"event", "job"}, {"job", id}, {"claim", "lost"}, {"seconds", seconds}});
+  log_line({{"event", "job"}, {"job", claim.job_id}, {"claim", "lost"}, {"seconds", seconds}});
+  discard_if_ended(claim);
+}
+
+void WorkerPool::discard_if_ended(const Claim& claim) {
+  try {
+    const auto job = store_.find(claim.job_id);
+    if (job && job->lease_token != claim.token &&
+        (job->status == JobStatus::successful || job->status == JobStatus::failed ||
+         job->status == JobStatus::dismissed)) {
+      std::error_code ec;
+      std::filesystem::remove_all(attempt_dir(claim), ec);
+    }
+  } catch (const std::exception& e) {  // the folder stays until retention removes the job
+    log_line({{"event", "store_error"}, {"job", claim.job_id}, {"detail", e.what()}});
+  }
 }
 
 void WorkerPool::end_dismissed(const JobRecord& job, const Claim& claim,
                                const std::vector<std::string>& written, double seconds) {
   const std::filesystem::path dir = job_dir(job.id);
+  const std::filesystem::path out = attempt_dir(claim);
   std::vector<ResultFile> files;
-  record_files(dir, written, files);
+  record_files(out, written, files);
   ClaimState state = ClaimState::lost;
   try {
     state = with_retries(job.id, "keep_results",
@@ -212,13 +254,14 @@ void WorkerPool::end_dismissed(const JobRecord& job, const Claim& claim,
     log_line({{"event", "store_error"}, {"job", job.id}, {"detail", e.what()}});
   }
   if (state == ClaimState::lost) {  // not ours any more: touch nothing
-    claim_lost(job.id, seconds);
+    claim_lost(claim, seconds);
     return;
   }
   const bool kept = state == ClaimState::held;
   std::error_code ec;
   if (kept) {
-    remove_checkpoints_but(dir);
+    remove_checkpoints_but(out);
+    remove_all_but_log(dir, out.filename().string());  // other attempts' folders
     append_run_log(dir, "cancelled after " + short_number(seconds) + " s wall; " +
                             std::to_string(files.size()) + " result files kept");
   } else {
@@ -237,6 +280,17 @@ WorkerPool::~WorkerPool() {
 
 std::filesystem::path WorkerPool::job_dir(const std::string& id) const {
   return settings_.data_dir / id;
+}
+
+std::filesystem::path WorkerPool::attempt_dir(const Claim& claim) const {
+  return job_dir(claim.job_id) / attempt_name(claim.token);
+}
+
+std::filesystem::path WorkerPool::results_dir(const JobRecord& job) const {
+  std::filesystem::path dir = job_dir(job.id) / attempt_name(job.lease_token);
+  std::error_code ec;
+  if (!std::filesystem::is_directory(dir, ec)) dir = job_dir(job.id);  // an older server's layout
+  return dir;
 }
 
 void WorkerPool::start() {
@@ -394,11 +448,13 @@ void WorkerPool::run_one(const JobRecord& job, Running& running) {
   const Claim claim = claim_of(job);
   log_transition(job.id, JobStatus::running, {{"attempt", job.attempts}});
   const std::filesystem::path dir = job_dir(job.id);
+  const std::filesystem::path out = attempt_dir(claim);  // this attempt's files, fenced
+  const std::string out_name = out.filename().string();
   auto parsed = hmpm::api::parse_job(job.spec, settings_.limits);
   // An earlier attempt's checkpoint: resume from it when it is intact, else
   // start afresh (the folder then loses that attempt's leftovers).
   std::optional<std::string> resume;
-  std::string checkpoint_file;  // the recorded checkpoint of this job, if any
+  std::string checkpoint_file;  // the recorded checkpoint of this job, if any (from `dir`)
   std::optional<CheckpointRecord> recorded;
   try {
     recorded = store_.checkpoint(job.id);
@@ -415,11 +471,27 @@ void WorkerPool::run_one(const JobRecord& job, Running& running) {
     }
   }
   if (resume) {
+    // The snapshots so far come along into this attempt's folder; the
+    // folder resumed from stays until this attempt records a checkpoint of
+    // its own (until then a crash resumes from the same one).
     checkpoint_file = recorded->file;
-    remove_checkpoints_but(dir, checkpoint_file);  // the snapshots so far stay
-  } else {
-    remove_all_but_log(dir);  // leftovers of an interrupted attempt
+    const std::string from = std::filesystem::path(checkpoint_file).begin()->string();
+    const bool legacy = from == checkpoint_file;  // an older server's file in `dir` itself
+    try {
+      if (legacy) {
+        carry_over(dir, out);
+      } else {
+        remove_all_but_log(dir, from);  // folders of attempts before that one
+        carry_over(dir / from, out);
+      }
+    } catch (const std::exception& e) {
+      append_run_log(dir, std::string("the results before the checkpoint could not be copied (") +
+                              e.what() + "): starting from step 0");
+      resume.reset();
+      checkpoint_file.clear();
+    }
   }
+  if (!resume) remove_all_but_log(dir);  // leftovers of interrupted attempts
   append_run_log(dir, "attempt " + std::to_string(job.attempts) + " started on " +
                           settings_.claimant.instance + ": " + std::to_string(job.cost.particles) +
                           " particles, " + std::to_string(job.cost.steps) + " steps, " +
@@ -481,8 +553,10 @@ void WorkerPool::run_one(const JobRecord& job, Running& running) {
         // shutdown only (a dismissed job, or one another claim took, is over).
         if (running.dismissed || running.lost) return;
         const auto t1 = SteadyClock::now();
-        const std::string name = checkpoint_prefix + std::to_string(claim.token) + "-" +
-                                 std::to_string(c.step) + checkpoint_suffix;
+        // Recorded relative to the job's folder:
+        // "attempt-<token>/checkpoint-<token>-<step>.hmpmck".
+        const std::string name = out_name + "/" + checkpoint_prefix + std::to_string(claim.token) +
+                                 "-" + std::to_string(c.step) + checkpoint_suffix;
         try {
           write_durably(dir / name, c.bytes);
           const CheckpointRecord rec{
@@ -500,6 +574,7 @@ void WorkerPool::run_one(const JobRecord& job, Running& running) {
           if (!checkpoint_file.empty() && checkpoint_file != name) {
             std::error_code ec;
             std::filesystem::remove(dir / checkpoint_file, ec);
+            remove_all_but_log(dir, out_name);  // the folder resumed from, if any
           }
           checkpoint_file = name;
           append_run_log(dir, "checkpoint at step " + std::to_string(c.step) + ", t = " +
@@ -513,8 +588,8 @@ void WorkerPool::run_one(const JobRecord& job, Running& running) {
       };
     }
     try {
-      std::filesystem::create_directories(dir);
-      result = hmpm::api::run_job(*parsed.job, dir, options);
+      std::filesystem::create_directories(out);
+      result = hmpm::api::run_job(*parsed.job, out, options);
       if (result.run.status == hmpm::RunStatus::successful) {
         outcome = JobStatus::successful;
       } else {
@@ -528,8 +603,8 @@ void WorkerPool::run_one(const JobRecord& job, Running& running) {
   }
   const double seconds = seconds_since(t0);
 
-  if (running.lost) {  // another instance owns the job and its folder now
-    claim_lost(job.id, seconds);
+  if (running.lost) {  // another instance owns the job now
+    claim_lost(claim, seconds);
     return;
   }
   if (running.dismissed) {
@@ -540,7 +615,7 @@ void WorkerPool::run_one(const JobRecord& job, Running& running) {
     const ClaimState state = with_retries(job.id, "requeue", [&] { return store_.requeue(claim); });
     if (state == ClaimState::dismissed) return end_dismissed(job, claim, result.files, seconds);
     if (state == ClaimState::lost) {
-      claim_lost(job.id, seconds);
+      claim_lost(claim, seconds);
       return;
     }
     if (checkpoint_file.empty()) {
@@ -557,23 +632,25 @@ void WorkerPool::run_one(const JobRecord& job, Running& running) {
   }
 
   std::vector<ResultFile> files;
-  if (const auto unreadable = record_files(dir, result.files, files)) {
+  if (const auto unreadable = record_files(out, result.files, files)) {
     outcome = JobStatus::failed;
     reason = "result file " + *unreadable + " could not be read back";
   }
-  remove_unlisted(dir, files);
+  remove_unlisted(out, files);
   const std::string message = outcome == JobStatus::successful ? "finished" : reason;
   // The end of a job must reach the store, or it would stay running until a
   // restart: a failing write (disk full) is retried with backoff.
   const ClaimState state = with_retries(job.id, "finish", [&] {
     return store_.finish(claim, JobEnd{outcome, message, reason, files, seconds});
   });
-  if (state == ClaimState::lost) {  // taken over while finishing: the files are not ours
-    claim_lost(job.id, seconds);
+  if (state == ClaimState::lost) {  // taken over while finishing: not served, never will be
+    claim_lost(claim, seconds);
     return;
   }
   if (state == ClaimState::dismissed) return end_dismissed(job, claim, result.files, seconds);
-  remove_checkpoints_but(dir);  // the job has ended: its checkpoints are of no use now
+  // The job has ended: its checkpoints and other attempts' folders are of no use now.
+  remove_checkpoints_but(out);
+  remove_all_but_log(dir, out_name);
   append_run_log(dir, std::string(status_name(outcome)) + " after " + short_number(seconds) +
                           " s wall, " + std::to_string(files.size()) + " result files" +
                           (reason.empty() ? "" : ": " + reason));

@@ -2,8 +2,14 @@
 //
 // Workers take the oldest accepted job from the store (FIFO), re-parse its
 // stored spec (the database stays the only source of truth), run it with
-// hmpm::api::run_job into `<data-dir>/<job id>/`, record the result files
-// with size and SHA-256, and write the outcome. HTTP handlers never run
+// hmpm::api::run_job into `<data-dir>/<job id>/attempt-<fencing token>/`,
+// record the result files with size and SHA-256, and write the outcome.
+// Result files are fenced like every other write: each claim writes only
+// into its own attempt folder, and the files served are those of the claim
+// whose fenced finish() (or keep_results()) was recorded, whose token the
+// job row keeps. A paused-then-revived server whose claim was taken over
+// can fill its own folder, never the one being served. The job's log
+// (`<data-dir>/<job id>/job.log`) spans all attempts. HTTP handlers never run
 // solver work; they only nudge the pool (`notify`) or ask it to cancel.
 //
 // Cancellation is cooperative: each running job has an atomic flag the solver
@@ -78,8 +84,14 @@ class WorkerPool {
   /// stop_claiming(), then joins the threads. Idempotent.
   void shutdown();
 
-  /// Where the result files of job `id` live.
+  /// The folder of job `id`: its log and one folder per attempt.
   std::filesystem::path job_dir(const std::string& id) const;
+  /// Where the attempt of `claim` writes its result and checkpoint files.
+  std::filesystem::path attempt_dir(const Claim& claim) const;
+  /// Where the result files of the ended job `job` live: the folder of the
+  /// claim that recorded them (its token is the row's), or the job folder
+  /// itself for a job that ended before attempt folders existed.
+  std::filesystem::path results_dir(const JobRecord& job) const;
 
  private:
   struct Running {
@@ -90,8 +102,12 @@ class WorkerPool {
   void work();
   void heartbeat();
   void run_one(const JobRecord& job, Running& running);
-  // A write of `id` was refused: another claim replaced ours (counted, logged).
-  void claim_lost(const std::string& id, double seconds);
+  // A write of `claim` was refused: another claim replaced ours (counted,
+  // logged); then discard_if_ended.
+  void claim_lost(const Claim& claim, double seconds);
+  // Removes the attempt folder of `claim` once its job has ended under
+  // another claim (nobody resumes from it or serves it any more).
+  void discard_if_ended(const Claim& claim);
   // The end of a dismissed run: keeps the files it `written` if the job was
   // cancelled, removes them if it was deleted (the store decides).
   void end_dismissed(const JobRecord& job, const Claim& claim,

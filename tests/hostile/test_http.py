@@ -279,7 +279,7 @@ class HttpDetailsTest(unittest.TestCase):
             status, _, _ = request(server, "GET", path, headers={"If-None-Match": '"nope"'})
             self.assertEqual(status, 200)
             # Changed on disk, same size: a new ETag.
-            on_disk = server.tmp / "results" / job / name
+            on_disk = server.tmp / "results" / job / "attempt-1" / name
             on_disk.write_bytes(whole[::-1])
             status, h, _ = request(server, "GET", path, headers={"If-None-Match": etag})
             self.assertEqual(status, 200)

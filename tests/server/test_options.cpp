@@ -123,6 +123,11 @@ TEST(Options, MistakesAreReportedNotFatal) {
   EXPECT_NE(parse_options({"--db", "d", "--bogus", "1"}, nullptr).error.find("unknown option"),
             std::string::npos);
   EXPECT_NE(parse_options({"--db"}, nullptr).error.find("needs a value"), std::string::npos);
+  // A URI that is not PostgreSQL's is refused, not taken for a SQLite path.
+  EXPECT_NE(parse_options({"--db", "mysql://u@127.0.0.1/db"}, nullptr).error.find("postgresql://"),
+            std::string::npos);
+  EXPECT_NE(parse_options({"--db", "postgresq://u@127.0.0.1/db"}, nullptr).error.find("URI"),
+            std::string::npos);
   EXPECT_TRUE(parse_options({"--help"}, nullptr).help);
 }
 

@@ -190,9 +190,15 @@ TEST_F(RoutesTest, SubmitPollAndDownloadResults) {
   EXPECT_TRUE(names.count("summary.json"));
   EXPECT_TRUE(names.count("series.json"));
   EXPECT_TRUE(names.count("series.csv"));
-  // Without --data-dir the files live beside the database, one folder per job.
+  // Without --data-dir the files live beside the database, one folder per
+  // job holding the log and one folder per attempt (its claim's fencing
+  // token; the first claim's is 1), and nothing else once the job has ended.
   EXPECT_EQ(service_->config().data_dir, dir_ / "db" / "results");
-  EXPECT_TRUE(std::filesystem::exists(dir_ / "db" / "results" / id / "series.json"));
+  EXPECT_TRUE(std::filesystem::exists(dir_ / "db" / "results" / id / "attempt-1" / "series.json"));
+  std::set<std::string> entries;
+  for (const auto& e : std::filesystem::directory_iterator(dir_ / "db" / "results" / id))
+    entries.insert(e.path().filename().string());
+  EXPECT_EQ(entries, (std::set<std::string>{"attempt-1", "job.log"}));
 }
 
 // A runnable spec with something worth knowing: the 201 carries the
@@ -647,7 +653,7 @@ TEST_F(RoutesTest, RetentionPurgesOldEndedJobsWithTheirFilesAndTheyAre404) {
   ASSERT_EQ(wait_final(done).value("status", ""), "successful");
   const std::string running = submit_running("still-running");
   const std::filesystem::path data = service_->config().data_dir;
-  ASSERT_TRUE(std::filesystem::exists(data / done / "summary.json"));
+  ASSERT_TRUE(std::filesystem::exists(data / done / "attempt-1" / "summary.json"));
   // A folder a crash left behind (no job), and one that is not a job's.
   const std::string orphan = "0123abcd-0000-4000-8000-000000000000";
   std::filesystem::create_directories(data / orphan);
