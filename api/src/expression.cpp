@@ -37,8 +37,11 @@ bool has_assignment(std::string_view s) {
 
 // Compiles with the given variables defined; returns the compiled object and
 // whether any variable is used. nullptr and `error` on failure.
-std::shared_ptr<Compiled> compile(std::string_view text, bool time_function, bool& uses_variables,
-                                  std::string& error) {
+// The variables a formula may use.
+enum class Variables { position, time, position_and_time };
+
+std::shared_ptr<Compiled> compile(std::string_view text, Variables vars, bool& uses_variables,
+                                  std::string& error, bool* uses_position = nullptr) {
   auto c = std::make_shared<Compiled>();
   if (text.empty()) {
     error = "is an empty formula; give a number or a formula";
@@ -54,9 +57,8 @@ std::shared_ptr<Compiled> compile(std::string_view text, bool time_function, boo
   }
   try {
     c->parser.DefineConst("pi", std::numbers::pi);
-    if (time_function) {
-      c->parser.DefineVar("t", &c->t);
-    } else {
+    if (vars != Variables::position) c->parser.DefineVar("t", &c->t);
+    if (vars != Variables::time) {
       c->parser.DefineVar("x", &c->x);
       c->parser.DefineVar("y", &c->y);
       c->parser.DefineVar("z", &c->z);
@@ -69,11 +71,16 @@ std::shared_ptr<Compiled> compile(std::string_view text, bool time_function, boo
               " comma-separated results; exactly one expected";
       return nullptr;
     }
-    uses_variables = !c->parser.GetUsedVar().empty();
+    const auto used = c->parser.GetUsedVar();
+    uses_variables = !used.empty();
+    if (uses_position)
+      *uses_position = used.count("x") > 0 || used.count("y") > 0 || used.count("z") > 0;
   } catch (const mu::Parser::exception_type& e) {
-    error = "bad formula '" + std::string(text) + "': " + e.GetMsg() +
-            " (variables: " + (time_function ? "t" : "x, y, z") + "; " +
-            std::string(expression_help) + ")";
+    error = "bad formula '" + std::string(text) + "': " + e.GetMsg() + " (variables: " +
+            (vars == Variables::time       ? "t"
+             : vars == Variables::position ? "x, y, z"
+                                           : "x, y, z, t") +
+            "; " + std::string(expression_help) + ")";
     return nullptr;
   }
   return c;
@@ -100,7 +107,7 @@ FieldOfTime constant_field_of_time(double value) {
 std::optional<FieldOfPosition> compile_field_of_position(std::string_view text,
                                                          std::string& error) {
   bool uses = false;
-  auto c = compile(text, false, uses, error);
+  auto c = compile(text, Variables::position, uses, error);
   if (!c) return std::nullopt;
   if (!uses) return constant_field_of_position(evaluate(*c));
   return FieldOfPosition([c](const Vec3& p) {
@@ -114,7 +121,7 @@ std::optional<FieldOfPosition> compile_field_of_position(std::string_view text,
 
 std::optional<FieldOfTime> compile_field_of_time(std::string_view text, std::string& error) {
   bool uses = false;
-  auto c = compile(text, true, uses, error);
+  auto c = compile(text, Variables::time, uses, error);
   if (!c) return std::nullopt;
   if (!uses) return constant_field_of_time(evaluate(*c));
   return FieldOfTime([c](double t) {
@@ -122,6 +129,28 @@ std::optional<FieldOfTime> compile_field_of_time(std::string_view text, std::str
     c->t = t;
     return evaluate(*c);
   });
+}
+
+std::optional<FieldOfSpaceTime> compile_field_of_space_time(std::string_view text,
+                                                            std::string& error,
+                                                            bool& varies_in_space) {
+  bool uses = false;
+  varies_in_space = false;
+  auto c = compile(text, Variables::position_and_time, uses, error, &varies_in_space);
+  if (!c) return std::nullopt;
+  if (!uses) return constant_field_of_space_time(evaluate(*c));
+  return FieldOfSpaceTime([c](const Vec3& p, double t) {
+    std::lock_guard lock(c->mutex);
+    c->x = p[0];
+    c->y = p[1];
+    c->z = p[2];
+    c->t = t;
+    return evaluate(*c);
+  });
+}
+
+FieldOfSpaceTime constant_field_of_space_time(double value) {
+  return [value](const Vec3&, double) { return value; };
 }
 
 }  // namespace hmpm::api

@@ -27,8 +27,15 @@ std::optional<FieldOfPosition> compile_field_of_position(std::string_view text, 
 /// Compiles `text` as a function of t. Same contract as above.
 std::optional<FieldOfTime> compile_field_of_time(std::string_view text, std::string& error);
 
+/// Compiles `text` as a function of x, y, z and t; `varies_in_space` says
+/// whether it uses x, y or z. Same contract as above.
+std::optional<FieldOfSpaceTime> compile_field_of_space_time(std::string_view text,
+                                                            std::string& error,
+                                                            bool& varies_in_space);
+
 /// Constant functions (no muParser involved).
 FieldOfPosition constant_field_of_position(double value);
 FieldOfTime constant_field_of_time(double value);
+FieldOfSpaceTime constant_field_of_space_time(double value);
 
 }  // namespace hmpm::api

@@ -234,14 +234,24 @@ bool node_selected(const Problem& problem, const NodeSelection& nodes, const Vec
   return true;
 }
 
-bool particle_selected(const Problem& problem, const Traction& traction, const Vec3& x) {
-  if (traction.polygon)
-    return geometry::inside_or_on(traction.polygon->vertices, {x[0], x[1]},
-                                  1e-6 * min_cell_size(problem));
+namespace {
+// A particle selection: a closed box of initial positions, or a polygon.
+bool in_selection(const Problem& problem, const Box& box, const std::optional<Polygon>& polygon,
+                  const Vec3& x) {
+  if (polygon)
+    return geometry::inside_or_on(polygon->vertices, {x[0], x[1]}, 1e-6 * min_cell_size(problem));
   for (int a = 0; a < problem.dimension; ++a)
-    if (x[a] < traction.particles.min[a] - 1e-12 || x[a] > traction.particles.max[a] + 1e-12)
-      return false;
+    if (x[a] < box.min[a] - 1e-12 || x[a] > box.max[a] + 1e-12) return false;
   return true;
+}
+}  // namespace
+
+bool particle_selected(const Problem& problem, const Traction& traction, const Vec3& x) {
+  return in_selection(problem, traction.particles, traction.polygon, x);
+}
+
+bool particle_selected(const Problem& problem, const Flux& flux, const Vec3& x) {
+  return in_selection(problem, flux.particles, flux.polygon, x);
 }
 
 std::vector<Vec3> initial_positions(const Problem& problem) {
@@ -361,6 +371,41 @@ void check_selection_polygon(const Problem& problem, const Polygon& polygon, con
     return;
   }
   check_polygon(polygon, w, issues);
+}
+
+// Fluxes and seepage faces: they act on the pore water, so they need a
+// saturated material; a seepage face is the explicit scheme's for now.
+void check_hydraulic_boundaries(const Problem& problem, std::vector<ProblemIssue>& issues) {
+  const bool saturated = std::any_of(problem.materials.begin(), problem.materials.end(),
+                                     [](const Material& m) { return m.hydraulic.has_value(); });
+  for (std::size_t i = 0; i < problem.fluxes.size(); ++i) {
+    const Flux& f = problem.fluxes[i];
+    const Location w = Location{"fluxes"} / i;
+    if (!saturated)
+      issues.push_back({w,
+                        "moves pore water, but no material has `hydraulic` (a dry run has "
+                        "none): give the soil's material a hydraulic section or remove the flux"});
+    if (f.axis < 0 || f.axis >= problem.dimension)
+      issues.push_back({w / "face", "names an axis this " + std::to_string(problem.dimension) +
+                                        "D problem does not have"});
+  }
+  for (std::size_t i = 0; i < problem.boundaries.size(); ++i) {
+    const Boundary& b = problem.boundaries[i];
+    if (!b.seepage) continue;
+    const Location w = Location{"boundaries"} / i / "seepage";
+    if (!saturated) issues.push_back({w, "needs pore water, but no material has `hydraulic`"});
+    if (b.pore_pressure)
+      issues.push_back({w,
+                        "cannot share an entry with pore_pressure: a seepage face decides its "
+                        "own pressure (p = 0 while water leaves); give the prescribed "
+                        "pressure its own boundary entry (it wins where both meet)"});
+    if (problem.time.scheme != Scheme::explicit_scheme)
+      issues.push_back({w, std::string("is available with the explicit scheme only in this "
+                                       "release; this job asks for ") +
+                               scheme_name(problem.time.scheme) +
+                               ": use time.scheme \"explicit\" or hold the face at p = 0 with "
+                               "pore_pressure (which also lets water in)"});
+  }
 }
 
 void check_body_shape(const Problem& problem, const Body& body, const Location& w,
@@ -515,6 +560,10 @@ std::vector<ProblemIssue> check_problem(const Problem& problem) {
     if (problem.tractions[i].polygon)
       check_selection_polygon(problem, *problem.tractions[i].polygon,
                               Location{"tractions"} / i / "particles" / "polygon", issues);
+  for (std::size_t i = 0; i < problem.fluxes.size(); ++i)
+    if (problem.fluxes[i].polygon)
+      check_selection_polygon(problem, *problem.fluxes[i].polygon,
+                              Location{"fluxes"} / i / "particles" / "polygon", issues);
   if (issues.size() > before_shapes) return issues;
   const std::vector<BodyLayout> layouts = body_layouts(problem);
   for (std::size_t b = 0; b < problem.bodies.size(); ++b) {
@@ -556,6 +605,7 @@ std::vector<ProblemIssue> check_problem(const Problem& problem) {
               std::to_string(prescribed));
     if (!(*bc.friction >= 0)) add(w, "must be >= 0");
   }
+  check_hydraulic_boundaries(problem, issues);
   if (!(problem.time.end > 0)) add({"time", "end"}, "must be > 0");
   if (!(problem.time.courant > 0 && problem.time.courant <= 1))
     add({"time", "courant"}, "must be in (0, 1]");

@@ -93,6 +93,9 @@ class Simulation {
   void compute_nodal_pressure(double t);
   void map_pore_pressure_force(const Out& out, std::size_t begin, std::size_t end);
   void apply_surface_loads(double t);
+  /// Water across particle faces at time t (Problem::fluxes) added to the
+  /// nodal flux; nothing without fluxes.
+  void apply_boundary_fluxes(double t);
   void update_nodal_momentum(double t, double dt);
   void update_particle_velocities_and_remap(const Out& out, std::size_t begin, std::size_t end,
                                             double dt);
@@ -238,6 +241,7 @@ class Simulation {
   std::vector<double> inv_ks_, inv_kf_;
   Constraints constraints_;
   std::vector<TractionLoad> tractions_;
+  std::vector<FluxLoad> fluxes_;  ///< saturated runs only
   Vec gravity_ = Vec::Zero();
   Vec grid_max_ = Vec::Zero();
   bool fluid_ = false;

@@ -453,3 +453,61 @@ TEST(ParseJob, FrictionNeedsExactlyOneNormalComponent) {
 
 }  // namespace
 }  // namespace hmpm::api
+
+namespace hmpm::api {
+namespace {
+
+// fluxes: a number or a formula in x, y, z, t (rate_varies_in_space says
+// which); boundaries[*].seepage; each mistake with its JSON pointer.
+TEST(ParseJob, FluxesAndSeepageFaces) {
+  json spec = json::parse(read_text(source_path("tests/api/data/valid-2d.json")));
+  spec["fluxes"] = json::parse(R"J([
+    {"particles": {"box": {"min": [0, 0.375], "max": [1, 0.5]}}, "face": "y+", "rate": 1e-5},
+    {"particles": {"polygon": [[0, 0.3], [1, 0.3], [1, 0.5], [0, 0.5]]}, "face": "x-",
+     "rate": "2e-6 * (1 + y) * min(t, 1)"}])J");
+  spec["boundaries"].push_back(
+      json::parse(R"({"nodes": {"box": {"min": [1, 0], "max": [1, 0.5]}}, "seepage": true})"));
+  const ParsedJob job = parse_valid(spec.dump());
+  const auto& f = job.problem.fluxes;
+  ASSERT_EQ(f.size(), 2u);
+  EXPECT_EQ(f[0].axis, 1);
+  EXPECT_EQ(f[0].side, +1);
+  EXPECT_FALSE(f[0].rate_varies_in_space);
+  EXPECT_DOUBLE_EQ(f[0].rate(Vec3{0.3, 0.4, 0}, 7.0), 1e-5);
+  EXPECT_EQ(f[1].axis, 0);
+  EXPECT_EQ(f[1].side, -1);
+  EXPECT_TRUE(f[1].polygon.has_value());
+  EXPECT_TRUE(f[1].rate_varies_in_space);
+  EXPECT_DOUBLE_EQ(f[1].rate(Vec3{0, 0.5, 0}, 0.5), 2e-6 * 1.5 * 0.5);
+  EXPECT_TRUE(job.problem.boundaries.back().seepage);
+
+  spec["fluxes"] = json::parse(R"J([
+    {"particles": "all", "face": "z+", "rate": 1e-5},
+    {"particles": "all", "face": "y+", "rate": "k * t"},
+    {"particles": "all", "face": "y+"},
+    {"particles": {"box": {"min": [0, 0.9], "max": [1, 1]}}, "face": "y+", "rate": 1e-5}])J");
+  spec["boundaries"].back()["seepage"] = "yes";
+  const ParseResult bad = parse_job(spec.dump());
+  std::map<std::string, std::string> at;
+  for (const SpecError& e : bad.errors) at[e.path] = e.message;
+  EXPECT_NE(at["/fluxes/0/face"].find("no z axis"), std::string::npos) << at["/fluxes/0/face"];
+  EXPECT_NE(at["/fluxes/1/rate"].find("x, y, z, t"), std::string::npos) << at["/fluxes/1/rate"];
+  EXPECT_NE(at["/fluxes/2/rate"].find("required"), std::string::npos) << "a flux without a rate";
+  EXPECT_NE(at["/boundaries/3/seepage"].find("true or false"), std::string::npos);
+  EXPECT_FALSE(bad.job.has_value());
+
+  // A flux on a dry problem, and a seepage face with the semi-implicit scheme.
+  json dry = json::parse(read_text(source_path("tests/api/data/valid-2d.json")));
+  dry["materials"]["sand"].erase("hydraulic");
+  dry["bodies"][0]["initial"].erase("pore_pressure");
+  dry["boundaries"].erase(2);
+  dry["fluxes"] = json::parse(R"J([{"particles": "all", "face": "y+", "rate": 1e-5}])J");
+  const ParseResult dry_r = parse_job(dry.dump());
+  bool named = false;
+  for (const SpecError& e : dry_r.errors)
+    named |= e.path == "/fluxes/0" && e.message.find("hydraulic") != std::string::npos;
+  EXPECT_TRUE(named);
+}
+
+}  // namespace
+}  // namespace hmpm::api

@@ -33,6 +33,22 @@ inline double darcy_pressure(double x, double t, double L, double dp, double c, 
   return p;
 }
 
+/// Pressure diffusion dp/dt = c p_xx on [0, L] with p(0) = 0, a constant
+/// inflow across x = L (p_x(L) = g, g = r gamma_w / k for a rate r into the
+/// soil, no gravity) and p = 0 at t = 0: p = g [x - sum_n 8 L (-1)^n /
+/// ((2n+1)^2 pi^2) sin(l_n x) exp(-l_n^2 c t)], l_n = (2n+1) pi / (2 L).
+inline double flux_column_pressure(double x, double t, double L, double g, double c,
+                                   int terms = 400) {
+  double p = g * x;
+  for (int n = 0; n < terms; ++n) {
+    const double l = (2 * n + 1) * pi / (2 * L);
+    const double e = std::exp(-l * l * c * t);
+    if (e < 1e-300) break;
+    p -= g * 8 * L * (n % 2 ? -1.0 : 1.0) / std::pow((2 * n + 1) * pi, 2) * std::sin(l * x) * e;
+  }
+  return p;
+}
+
 /// Terzaghi excess pore pressure, z from the drained face (§3).
 inline double terzaghi_pressure(double z, double tv, double H, double q, int terms = 400) {
   double p = 0;

@@ -1,5 +1,6 @@
 // boundaries.cpp — the "boundaries" section: grid nodes with prescribed
-// velocity components, pore pressure, rigid ties and wall friction.
+// velocity components, pore pressure, rigid ties, wall friction and seepage
+// faces.
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -33,8 +34,8 @@ std::int64_t count_selected_nodes(const Problem& p, const NodeSelection& nodes, 
   return n;
 }
 
-constexpr std::string_view boundary_allowed[] = {"nodes", "velocity", "pore_pressure", "rigid",
-                                                 "friction"};
+constexpr std::string_view boundary_allowed[] = {"nodes", "velocity", "pore_pressure",
+                                                 "rigid", "friction", "seepage"};
 constexpr std::string_view boundary_required[] = {"nodes"};
 
 void read_boundary(ParseContext& c, const json& j, const std::string& path) {
@@ -61,8 +62,10 @@ void read_boundary(ParseContext& c, const json& j, const std::string& path) {
       }
     }
   }
-  if (!j.contains("velocity") && !j.contains("pore_pressure") && !j.contains("rigid"))
-    r.error(path, "needs 'velocity', 'pore_pressure' and/or 'rigid'");
+  if (j.contains("seepage"))
+    if (const auto s = r.boolean(j["seepage"], path + "/seepage")) b.seepage = *s;
+  if (!j.contains("velocity") && !j.contains("pore_pressure") && !j.contains("rigid") && !b.seepage)
+    r.error(path, "needs 'velocity', 'pore_pressure', 'rigid' and/or 'seepage'");
   if (j.contains("velocity")) {
     const json& v = j["velocity"];
     const std::string vp = path + "/velocity";

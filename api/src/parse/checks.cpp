@@ -189,23 +189,30 @@ void resolve_series_polygons(ParseContext& c) {
   parts = std::move(out);
 }
 
-void check_traction_selections(ParseContext& c) {
-  // A convenience check, skipped when it would cost more than a moment.
+// Every traction or flux selects at least one particle. A convenience
+// check, skipped when it would cost more than a moment.
+template <class Load>
+void check_face_selections(ParseContext& c, const std::vector<Load>& loads,
+                           const std::vector<std::string>& paths) {
   const Problem& p = c.p;
-  if (p.tractions.empty() ||
-      static_cast<double>(p.tractions.size()) * static_cast<double>(count_particles(p)) >
-          max_near_work)
+  if (loads.empty() ||
+      static_cast<double>(loads.size()) * static_cast<double>(count_particles(p)) > max_near_work)
     return;
   const std::vector<Vec3> positions = initial_positions(p);
-  for (std::size_t k = 0; k < p.tractions.size(); ++k) {
+  for (std::size_t k = 0; k < loads.size(); ++k) {
     const bool any = std::any_of(positions.begin(), positions.end(), [&](const Vec3& x) {
-      return particle_selected(p, p.tractions[k], x);  // as the solver selects
+      return particle_selected(p, loads[k], x);  // as the solver selects
     });
     if (!any)
-      c.r.error(c.traction_paths[k],
+      c.r.error(paths[k],
                 "selects no particle; particles sit at sub-cell centres, e.g. the "
                 "top row of a body is half a particle spacing below its top face");
   }
+}
+
+void check_traction_selections(ParseContext& c) {
+  check_face_selections(c, c.p.tractions, c.traction_paths);
+  check_face_selections(c, c.p.fluxes, c.flux_paths);
 }
 
 void check_time_formulas(ParseContext& c) {

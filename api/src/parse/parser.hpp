@@ -80,6 +80,7 @@ struct ParseContext {
   std::int64_t formula_characters = 0;  ///< of every formula read so far
   std::size_t formulas = 0;             ///< formulas read so far
   std::vector<std::string> traction_paths;
+  std::vector<std::string> flux_paths;  ///< "/fluxes/i/particles", for selection errors
   bool any_pore_pressure_bc = false;
   std::string first_pore_pressure_bc;
   /// Runnable but worth knowing (e.g. time.implicit with the explicit
@@ -95,6 +96,7 @@ void read_materials(ParseContext& c, const json& j, const std::string& path);
 void read_bodies(ParseContext& c, const json& j, const std::string& path);
 void read_boundaries(ParseContext& c, const json& j, const std::string& path);
 void read_tractions(ParseContext& c, const json& j, const std::string& path);
+void read_fluxes(ParseContext& c, const json& j, const std::string& path);
 void read_time(ParseContext& c, const json& j, const std::string& path);
 void read_local_damping(ParseContext& c, const json& j, const std::string& path);
 void read_initial_state(ParseContext& c, const json& j, const std::string& path);
@@ -121,6 +123,12 @@ FieldOfPosition read_value_of_position(ParseContext& c, const json& j, const std
 /// A number or a formula in t (recorded for the finiteness check).
 std::optional<FieldOfTime> read_value_of_time(ParseContext& c, const json& j,
                                               const std::string& path);
+/// A number or a formula in x, y, z, t; `varies_in_space` says whether it
+/// uses x, y or z. Checked for finite values over [0, end] at the grid's
+/// centre (with the formulas of time).
+std::optional<FieldOfSpaceTime> read_value_of_space_time(ParseContext& c, const json& j,
+                                                         const std::string& path,
+                                                         bool& varies_in_space);
 
 // ------------------------------------------------------ whole-problem checks
 /// Particle budget, "near" selections, the solver's check_problem,
@@ -138,6 +146,7 @@ void material_keys(std::vector<SpecObjectKeys>& out);
 void body_keys(std::vector<SpecObjectKeys>& out);
 void boundary_keys(std::vector<SpecObjectKeys>& out);
 void traction_keys(std::vector<SpecObjectKeys>& out);
+void flux_keys(std::vector<SpecObjectKeys>& out);
 void initial_state_keys(std::vector<SpecObjectKeys>& out);
 void time_keys(std::vector<SpecObjectKeys>& out);
 void output_keys(std::vector<SpecObjectKeys>& out);

@@ -231,6 +231,39 @@ std::optional<FieldOfTime> read_value_of_time(ParseContext& c, const json& j,
   return std::nullopt;
 }
 
+std::optional<FieldOfSpaceTime> read_value_of_space_time(ParseContext& c, const json& j,
+                                                         const std::string& path,
+                                                         bool& varies_in_space) {
+  varies_in_space = false;
+  if (j.is_string()) {
+    const std::string& text = j.get_ref<const std::string&>();
+    if (!admit_formula(c, text, path)) return std::nullopt;
+    std::string error;
+    if (auto f = compile_field_of_space_time(text, error, varies_in_space)) {
+      // The finiteness check of the formulas of time, at the grid's centre.
+      const Problem& p = c.p;
+      c.time_formulas.push_back({path,
+                                 [&p, f = *f](double t) {
+                                   Vec3 mid{};
+                                   for (int a = 0; a < 3; ++a)
+                                     mid[a] = 0.5 * (p.grid.min[a] + p.grid.max[a]);
+                                   return f(mid, t);
+                                 },
+                                 text.size()});
+      return f;
+    }
+    c.r.error(path, error);
+    return std::nullopt;
+  }
+  if (!j.is_number()) {
+    c.r.error(path, std::string("expected a number or a formula string in x, y, z, t, got ") +
+                        j.type_name());
+    return std::nullopt;
+  }
+  if (auto v = c.r.number(j, path)) return constant_field_of_space_time(*v);
+  return std::nullopt;
+}
+
 std::string quoted_list(const std::vector<std::string>& words) {
   std::string out;
   for (std::size_t i = 0; i < words.size(); ++i) {

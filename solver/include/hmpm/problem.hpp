@@ -36,6 +36,10 @@ using FieldOfPosition = std::function<double(const Vec3& x)>;
 /// An empty function means "zero".
 using FieldOfTime = std::function<double(double t)>;
 
+/// A value that may depend on position x and time t — fluxes. x is the
+/// particle's initial position. An empty function means "zero".
+using FieldOfSpaceTime = std::function<double(const Vec3& x, double t)>;
+
 /// Axis-aligned box [min, max] (closed). Components beyond the dimension are ignored.
 struct Box {
   Vec3 min{0.0, 0.0, 0.0};
@@ -177,6 +181,11 @@ struct Boundary {
   /// +infinity: no slip ("rough"). std::nullopt: no friction (free
   /// components untouched).
   std::optional<double> friction;
+  /// A seepage face on these nodes (saturated runs): water may leave but
+  /// not enter. Each step a node whose pressure would rise above zero is
+  /// held at p = 0 (it drains); one below zero is left free (no flow in).
+  /// Not with a prescribed pore_pressure on the same entry.
+  bool seepage = false;
 };
 
 /// Surface load on one face of the particles inside `particles`.
@@ -189,6 +198,22 @@ struct Traction {
   int axis = 0;                         ///< face normal axis: 0 = x, 1 = y, 2 = z
   int side = +1;                        ///< +1 for "x+", -1 for "x-"
   std::array<FieldOfTime, 3> traction;  ///< Pa, per axis
+};
+
+/// Water flowing across one face of the particles inside `particles`
+/// (or `polygon`): a volumetric flux per unit area, m/s, positive into the
+/// soil (rainfall infiltration, a recharge well, a drain when negative).
+/// Mapped like a Traction, at the loaded face of each selected particle,
+/// with the face area V / length0 (V0 / length0 in the quasi-static scheme).
+struct Flux {
+  Box particles;                   ///< closed box of initial positions; used when no polygon
+  std::optional<Polygon> polygon;  ///< 2D: replaces the box when set
+  int axis = 0;                    ///< face normal axis
+  int side = +1;                   ///< +1 for "x+", -1 for "x-"
+  /// m/s into the soil at (initial position, t).
+  FieldOfSpaceTime rate;
+  /// false: `rate` does not depend on x, evaluated once per step.
+  bool rate_varies_in_space = false;
 };
 
 /// Geostatic initial state of horizontally layered ground (verification §6).
@@ -311,6 +336,7 @@ struct Problem {
   Vec3 gravity{0.0, 0.0, 0.0};  ///< m/s^2
   std::vector<Boundary> boundaries;
   std::vector<Traction> tractions;
+  std::vector<Flux> fluxes;  ///< saturated runs only (check_problem)
   TimeControl time;
   OutputRequest output;
   /// Acceleration of gravity used for the unit weight of water gamma_w = rho_f * g.

@@ -112,6 +112,8 @@ bool node_selected(const Problem& problem, const NodeSelection& nodes, const Vec
 /// Whether a particle with initial position `x` is loaded by the traction
 /// (inside its box, or inside or on its polygon as node_selected).
 bool particle_selected(const Problem& problem, const Traction& traction, const Vec3& x);
+/// The same for a flux.
+bool particle_selected(const Problem& problem, const Flux& flux, const Vec3& x);
 
 /// Index of the particle whose initial position is nearest to `x`; -1 if none.
 std::int64_t nearest_particle(const Problem& problem, const Vec3& x);

@@ -20,9 +20,11 @@
 //      symmetry plane meeting a floor keeps its own component).
 // Pore pressure constraints act on the pressure field only and never
 // conflict with the velocity mechanisms; two pressure boundaries on one node:
-// the later in the Problem wins.
+// the later in the Problem wins. A seepage face never holds a node whose
+// pressure a boundary prescribes (compile_constraints leaves it out).
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 
@@ -198,6 +200,26 @@ inline void apply_pressure_increment_constraints(const Constraints& c, GridState
     const double value = (*bc.fn)(t_new);
     for (std::int64_t i : bc.nodes) grid.dp[i] = value - grid.pressure[i];
   }
+}
+
+/// Seepage faces on the nodal pressure at the start of a step: a face node
+/// never holds a positive pressure (water there drains: p = 0).
+template <int Dim>
+inline void apply_seepage_pressure(const Constraints& c, GridState<Dim>& grid) {
+  for (const SeepageFace& face : c.seepage)
+    for (std::int64_t i : face.nodes) grid.pressure[i] = std::min(grid.pressure[i], 0.0);
+}
+
+/// Seepage faces on the explicit pressure increment: a node whose pressure
+/// would rise above zero is held at zero (the water that would have raised
+/// it leaves through the face); one that stays at or below zero is left
+/// free (no water enters). Explicit in time, this is the exact
+/// complementarity p <= 0, outflow >= 0, p * outflow = 0 of each step.
+template <int Dim>
+inline void apply_seepage_increment(const Constraints& c, GridState<Dim>& grid) {
+  for (const SeepageFace& face : c.seepage)
+    for (std::int64_t i : face.nodes)
+      if (grid.pressure[i] + grid.dp[i] > 0.0) grid.dp[i] = -grid.pressure[i];
 }
 
 }  // namespace hmpm

@@ -51,11 +51,18 @@ struct PressureConstraint {
   const FieldOfTime* fn = nullptr;
 };
 
+/// Seepage face nodes (Boundary::seepage), less those whose pore pressure
+/// a boundary prescribes (a prescribed value wins).
+struct SeepageFace {
+  std::vector<std::int64_t> nodes;
+};
+
 /// Every constraint of a run.
 struct Constraints {
   std::vector<VelocityConstraint> velocity;
   std::vector<RigidTie> rigid_ties;
   std::vector<PressureConstraint> pressure;
+  std::vector<SeepageFace> seepage;
   /// Per node (saturated runs): bit a set when a boundary prescribes or ties
   /// component a. Empty in dry runs.
   std::vector<std::uint8_t> prescribed_axes;
@@ -105,9 +112,18 @@ Constraints compile_constraints(const Problem& problem, const GridState<Dim>& gr
       c.velocity.push_back(std::move(vc));
     }
     if (b.rigid[0] || b.rigid[1] || b.rigid[2]) c.rigid_ties.push_back({nodes, b.rigid});
+    if (b.seepage && fluid) c.seepage.push_back({nodes});
     if (b.pore_pressure && fluid) c.pressure.push_back({std::move(nodes), &*b.pore_pressure});
   }
   if (!fluid) return c;
+  if (!c.seepage.empty()) {
+    std::vector<std::uint8_t> prescribed(static_cast<std::size_t>(grid.count), 0);
+    for (const PressureConstraint& bc : c.pressure)
+      for (std::int64_t i : bc.nodes) prescribed[static_cast<std::size_t>(i)] = 1;
+    for (SeepageFace& face : c.seepage)
+      std::erase_if(face.nodes,
+                    [&](std::int64_t i) { return prescribed[static_cast<std::size_t>(i)]; });
+  }
   c.prescribed_axes.assign(static_cast<std::size_t>(grid.count), 0);
   for (const VelocityConstraint& bc : c.velocity)
     for (int a = 0; a < Dim; ++a)

@@ -4,7 +4,8 @@
 // position lies in its box or polygon. Compiled once at set-up (compile_tractions);
 // each step the load is mapped to the nodes at the loaded face of each
 // particle, with the face area following the particle's volume change
-// (apply_tractions).
+// (apply_tractions). A Flux (water across a face) is selected and mapped
+// the same way, into the nodal flux of the mass balance (apply_fluxes).
 #pragma once
 
 #include <algorithm>
@@ -21,14 +22,50 @@
 
 namespace hmpm {
 
-struct TractionLoad {
-  const Traction* source = nullptr;
+/// The particles loaded on one face (a traction's or a flux's), at their
+/// initial volumes.
+struct FaceParticles {
   int axis = 0;
   int side = 1;
   std::vector<std::int64_t> particles;
-  std::vector<double> length0;
+  std::vector<double> length0;  ///< initial length along the face normal
   std::vector<double> volume0;
 };
+
+struct TractionLoad : FaceParticles {
+  const Traction* source = nullptr;
+};
+
+/// Water across a face (Flux): the selected particles and, when the rate
+/// depends on position, their initial positions.
+struct FluxLoad : FaceParticles {
+  const Flux* source = nullptr;
+  std::vector<Vec3> x0;  ///< empty unless source->rate_varies_in_space
+};
+
+/// The particles of `x0` (initial positions) that `source` selects, on its
+/// face. Initial length along the normal: the cell size over the body's
+/// particles per axis, recovered from the initial volume (particles of a
+/// body are not cubes when cells are not).
+template <int Dim, class Source>
+FaceParticles select_face_particles(const Problem& problem, const Source& source,
+                                    const std::vector<Vec3>& x0,
+                                    const ParticleState<Dim>& particles,
+                                    const GridState<Dim>& grid) {
+  FaceParticles face;
+  face.axis = source.axis;
+  face.side = source.side;
+  double cell_volume = 1.0;
+  for (int a = 0; a < Dim; ++a) cell_volume *= grid.h[a];
+  for (std::size_t p = 0; p < x0.size(); ++p) {
+    if (!particle_selected(problem, source, x0[p])) continue;
+    face.particles.push_back(static_cast<std::int64_t>(p));
+    const double n_per_axis = std::round(std::pow(cell_volume / particles.volume[p], 1.0 / Dim));
+    face.length0.push_back(grid.h[face.axis] / std::max(n_per_axis, 1.0));
+    face.volume0.push_back(particles.volume[p]);
+  }
+  return face;
+}
 
 /// The loads of `problem` on the particles at their initial volumes.
 template <int Dim>
@@ -39,56 +76,86 @@ std::vector<TractionLoad> compile_tractions(const Problem& problem,
   const std::vector<Vec3> x0 = initial_positions(problem);
   for (const Traction& t : problem.tractions) {
     TractionLoad load;
+    static_cast<FaceParticles&>(load) = select_face_particles(problem, t, x0, particles, grid);
     load.source = &t;
-    load.axis = t.axis;
-    load.side = t.side;
-    for (std::size_t p = 0; p < x0.size(); ++p) {
-      if (!particle_selected(problem, t, x0[p])) continue;
-      load.particles.push_back(static_cast<std::int64_t>(p));
-      // Initial length along the face normal: the cell size over the body's
-      // particles per cell, recovered from the initial volume per axis.
-      load.length0.push_back(std::pow(particles.volume[p], 1.0 / Dim));
-      load.volume0.push_back(particles.volume[p]);
-    }
     tractions.push_back(std::move(load));
   }
-  // Particles of a body are not cubes when cells are not; use the cell size
-  // along the normal over particles per cell when available.
-  for (TractionLoad& load : tractions)
-    for (std::size_t k = 0; k < load.particles.size(); ++k) {
-      const auto p = static_cast<std::size_t>(load.particles[k]);
-      double ppc_volume = 1.0;
-      for (int a = 0; a < Dim; ++a) ppc_volume *= grid.h[a];
-      const double n_per_axis = std::round(std::pow(ppc_volume / particles.volume[p], 1.0 / Dim));
-      load.length0[k] = grid.h[load.axis] / std::max(n_per_axis, 1.0);
-    }
   return tractions;
 }
 
+/// The fluxes of `problem` (saturated runs).
+template <int Dim>
+std::vector<FluxLoad> compile_fluxes(const Problem& problem, const ParticleState<Dim>& particles,
+                                     const GridState<Dim>& grid) {
+  std::vector<FluxLoad> fluxes;
+  if (problem.fluxes.empty()) return fluxes;
+  const std::vector<Vec3> x0 = initial_positions(problem);
+  for (const Flux& f : problem.fluxes) {
+    FluxLoad load;
+    static_cast<FaceParticles&>(load) = select_face_particles(problem, f, x0, particles, grid);
+    load.source = &f;
+    if (f.rate_varies_in_space)
+      for (std::int64_t p : load.particles) load.x0.push_back(x0[static_cast<std::size_t>(p)]);
+    fluxes.push_back(std::move(load));
+  }
+  return fluxes;
+}
+
+/// Calls add(node, N area) for the nodes of the loaded face of particle k of
+/// `face`: the face lies half the particle's current length along the
+/// normal from its centre; its area follows the particle's volume, V /
+/// length0 (a follower load: the explicit schemes), or with DeadLoad keeps
+/// its initial area V0 / length0 (the quasi-static scheme).
+template <int Dim, class Shape, bool DeadLoad, class Add>
+inline void for_face_nodes(const FaceParticles& face, std::size_t k,
+                           const ParticleState<Dim>& particles, const GridState<Dim>& grid,
+                           shape::Stencil<Dim, Shape>& s, Add&& add) {
+  using StencilT = shape::Stencil<Dim, Shape>;
+  const auto p = static_cast<std::size_t>(face.particles[k]);
+  const double stretch = std::pow(particles.volume[p] / face.volume0[k], 1.0 / Dim);
+  const double area = (DeadLoad ? face.volume0[k] : particles.volume[p]) / face.length0[k];
+  VecD<Dim> at = particles.x[p];
+  at[face.axis] += face.side * 0.5 * face.length0[k] * stretch;
+  s.compute(at, grid.origin, grid.inv_h, grid.cells, grid.stride,
+            particles.half_length.empty() ? 0.0 : particles.half_length[p]);
+  for (int n = 0; n < StencilT::N; ++n) add(s.node[n], s.w[n] * area);
+}
+
 /// Surface loads at time t, mapped at the loaded face of each selected
-/// particle and added to the nodal force. The face's area follows the
-/// particle's volume, V / length0 (a follower load: the explicit schemes);
-/// DeadLoad keeps its initial area V0 / length0 (a load fixed in size: the
+/// particle and added to the nodal force (for_face_nodes; DeadLoad: the
 /// quasi-static scheme, whose Terzaghi and Mandel loads are fixed forces).
 template <int Dim, class Shape, bool DeadLoad = false>
 inline void apply_tractions(const std::vector<TractionLoad>& tractions,
                             const ParticleState<Dim>& particles, GridState<Dim>& grid, double t) {
   using Vec = VecD<Dim>;
-  using StencilT = shape::Stencil<Dim, Shape>;
-  StencilT s;
+  shape::Stencil<Dim, Shape> s;
   for (const TractionLoad& load : tractions) {
     Vec traction;
     for (int a = 0; a < Dim; ++a)
       traction[a] = load.source->traction[a] ? load.source->traction[a](t) : 0.0;
+    for (std::size_t k = 0; k < load.particles.size(); ++k)
+      for_face_nodes<Dim, Shape, DeadLoad>(
+          load, k, particles, grid, s,
+          [&](std::int64_t node, double wa) { grid.force[node] += wa * traction; });
+  }
+}
+
+/// Water across the faces at time t into the nodal flux (the right-hand
+/// side of s_i dp_i/dt): N area rate, positive into the soil.
+template <int Dim, class Shape, bool DeadLoad = false>
+inline void apply_fluxes(const std::vector<FluxLoad>& fluxes, const ParticleState<Dim>& particles,
+                         GridState<Dim>& grid, double t) {
+  shape::Stencil<Dim, Shape> s;
+  for (const FluxLoad& load : fluxes) {
+    const FieldOfSpaceTime& rate = load.source->rate;
+    if (!rate) continue;
+    const double uniform = load.x0.empty() ? rate(Vec3{0.0, 0.0, 0.0}, t) : 0.0;
     for (std::size_t k = 0; k < load.particles.size(); ++k) {
-      const auto p = static_cast<std::size_t>(load.particles[k]);
-      const double stretch = std::pow(particles.volume[p] / load.volume0[k], 1.0 / Dim);
-      const double area = (DeadLoad ? load.volume0[k] : particles.volume[p]) / load.length0[k];
-      Vec face = particles.x[p];
-      face[load.axis] += load.side * 0.5 * load.length0[k] * stretch;
-      s.compute(face, grid.origin, grid.inv_h, grid.cells, grid.stride,
-                particles.half_length.empty() ? 0.0 : particles.half_length[p]);
-      for (int n = 0; n < StencilT::N; ++n) grid.force[s.node[n]] += s.w[n] * area * traction;
+      const double r = load.x0.empty() ? uniform : rate(load.x0[k], t);
+      for_face_nodes<Dim, Shape, DeadLoad>(load, k, particles, grid, s,
+                                           [&](std::int64_t node, double wa) {
+                                             grid.flux[static_cast<std::size_t>(node)] += wa * r;
+                                           });
     }
   }
 }

@@ -80,4 +80,9 @@ inline void Simulation<Dim, Shape>::apply_surface_loads(double t) {
   apply_tractions<Dim, Shape>(tractions_, particles_, grid_, t);
 }
 
+template <int Dim, class Shape>
+inline void Simulation<Dim, Shape>::apply_boundary_fluxes(double t) {
+  apply_fluxes<Dim, Shape>(fluxes_, particles_, grid_, t);
+}
+
 }  // namespace hmpm

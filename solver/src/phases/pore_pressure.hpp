@@ -21,6 +21,7 @@ inline void Simulation<Dim, Shape>::compute_nodal_pressure(double t) {
       grid_.pressure[i] = grid_.storage[i] > 0 ? grid_.pressure[i] / grid_.storage[i] : 0.0;
   });
   apply_pressure_constraints(constraints_, grid_, t);
+  apply_seepage_pressure(constraints_, grid_);
 }
 
 /// Phase 2 (saturated): the pore pressure interpolated from the nodes,
@@ -48,6 +49,7 @@ inline void Simulation<Dim, Shape>::update_nodal_pressure(double t_new, double d
       grid_.dp[i] = grid_.storage[i] > 0 ? dt * grid_.flux[i] / grid_.storage[i] : 0.0;
   });
   apply_pressure_increment_constraints(constraints_, grid_, t_new);
+  apply_seepage_increment(constraints_, grid_);
 }
 
 /// Phase 5 (saturated): particle pressure state += sum N dp_i (FLIP);

@@ -48,6 +48,7 @@ class ExplicitScheme final : public TimeScheme {
     sim_.compute_remapped_nodal_velocity(t + dt, dt);
     update_particle_stress_and_fluid_flux(dt);
     if (sim_.fluid_) {
+      sim_.apply_boundary_fluxes(t);
       sim_.update_nodal_pressure(t + dt, dt);
       update_particle_pressure_and_position(dt);
     }

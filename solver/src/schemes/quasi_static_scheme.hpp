@@ -354,6 +354,11 @@ class QuasiStaticScheme final : public TimeScheme {
     // External nodal forces at t + h: tractions (gravity is per particle).
     for (std::size_t i = 0; i < nodes; ++i) grid.force[i].setZero();
     apply_dead_loads(t + h);
+    // Water across faces at t + h (backward Euler), on the initial face areas.
+    if (!sim_.fluxes_.empty()) {
+      std::fill(grid.flux.begin(), grid.flux.end(), 0.0);
+      apply_fluxes<Dim, Shape, /*DeadLoad=*/true>(sim_.fluxes_, sim_.particles_, grid, t + h);
+    }
     const ImplicitControl& c = sim_.problem_.time.implicit;
     history_.resize(static_cast<std::size_t>(c.max_iterations) + 1);  // no-op after the first
     for (int it = 0;; ++it) {
@@ -466,6 +471,14 @@ class QuasiStaticScheme final : public TimeScheme {
         if (d < 0) continue;
         rhs_[d] += grid.force[i][a] * inv_e;
         ref_[d] += std::abs(grid.force[i][a]) * inv_e;
+      }
+    // Water across faces: the mass balance loses h times the inflow.
+    if (!sim_.fluxes_.empty())
+      for (std::size_t i = 0; i < static_cast<std::size_t>(grid.count); ++i) {
+        const std::int64_t d = pdof_[i];
+        if (d < 0) continue;
+        rhs_[d] -= h * grid.flux[i];
+        ref_[d] += std::abs(h * grid.flux[i]);
       }
     // The particles, in one fixed chunk per thread: thread 0 adds into
     // rhs_, ref_ and the matrix, thread t > 0 into its private copies

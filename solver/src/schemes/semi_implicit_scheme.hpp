@@ -153,6 +153,7 @@ class SemiImplicitScheme final : public TimeScheme {
     sim_.for_particles(nodal::bit(nodal::flux), [&](const Out& out, std::size_t b, std::size_t e) {
       sim_.map_predicted_fluid_flux(out, b, e);
     });
+    sim_.apply_boundary_fluxes(t + dt);
     sim_.for_nodes([&](std::int64_t b, std::int64_t e) {
       for (std::int64_t i = b; i < e; ++i) grid.remap[i].setZero();
     });
