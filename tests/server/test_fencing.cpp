@@ -147,6 +147,7 @@ struct FileState {
 };
 
 // For gtest's failure messages.
+// NOLINTNEXTLINE(readability-identifier-naming): GoogleTest looks the printer up by this name.
 void PrintTo(const FileState& f, std::ostream* os) {
   *os << "{sha256 " << f.sha256 << ", inode " << f.inode << ", mtime " << f.mtime_ns << " ns}";
 }
