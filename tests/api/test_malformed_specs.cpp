@@ -157,8 +157,9 @@ const Mutation mutations[] = {
      "/bodies/0/initial/effective_stress", "6"},
     {"pore_pressure_on_dry_material", "/bodies/1/initial", R"({"pore_pressure": 5})",
      "/bodies/1/initial/pore_pressure", "no 'hydraulic'"},
-    {"boundary_time_expression_uses_x", "/boundaries/2/pore_pressure", "\"x+1\"",
-     "/boundaries/2/pore_pressure", "bad formula"},
+    // A velocity is a value of t (a pore pressure may use x, y, z too).
+    {"boundary_time_expression_uses_x", "/boundaries/0/velocity/1", "\"x+1\"",
+     "/boundaries/0/velocity/1", "bad formula"},
     {"boundary_velocity_length", "/boundaries/0/velocity", "[0, 0, 0]", "/boundaries/0/velocity",
      "expected 2"},
     {"boundary_nodes_word", "/boundaries/0/nodes", "\"everything\"", "/boundaries/0/nodes",

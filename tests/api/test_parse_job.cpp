@@ -480,6 +480,14 @@ TEST(ParseJob, FluxesAndSeepageFaces) {
   EXPECT_TRUE(f[1].rate_varies_in_space);
   EXPECT_DOUBLE_EQ(f[1].rate(Vec3{0, 0.5, 0}, 0.5), 2e-6 * 1.5 * 0.5);
   EXPECT_TRUE(job.problem.boundaries.back().seepage);
+  // pore_pressure in x, y, z, t: a reservoir; in t alone: no field.
+  EXPECT_FALSE(job.problem.boundaries[2].pore_pressure_field);
+  spec["boundaries"][2]["pore_pressure"] = "9810 * max(0, 0.5 + t - y)";
+  const ParsedJob reservoir = parse_valid(spec.dump());
+  const Boundary& rb = reservoir.problem.boundaries[2];
+  ASSERT_TRUE(rb.pore_pressure_field);
+  EXPECT_DOUBLE_EQ(rb.pore_pressure_field(Vec3{0.3, 0.25, 0}, 0.25), 9810 * 0.5);
+  EXPECT_DOUBLE_EQ(rb.pore_pressure_field(Vec3{0.3, 0.9, 0}, 0.25), 0.0);
 
   spec["fluxes"] = json::parse(R"J([
     {"particles": "all", "face": "z+", "rate": 1e-5},

@@ -148,8 +148,8 @@ double transient_error(const Column& col, double rate) {
   for (std::size_t row = 0; row < s.time.size(); ++row) {
     if (s.time[row] * col.c() / (col.L * col.L) < 0.02) continue;
     for (std::size_t i = 0; i < np; ++i) {
-      const double exact = closed_form::flux_column_pressure(s.initial_positions[i][0],
-                                                             s.time[row], col.L, g, col.c());
+      const double exact = closed_form::flux_column_pressure(s.initial_positions[i][0], s.time[row],
+                                                             col.L, g, col.c());
       worst = std::max(worst, std::abs(s.values[0][row * np + i] - exact));
     }
   }
@@ -239,6 +239,55 @@ TEST(HydraulicBoundaries, SeepageFaceBelowHydrostaticTakesNoWaterIn) {
   ASSERT_EQ(rh.status, hmpm::RunStatus::successful) << rh.message;
   EXPECT_LT(rh.series.values[1][(rh.series.time.size() - 1) * np], -0.1 * col.k)
       << "a face held at p = 0 should draw water down the column";
+}
+
+// A reservoir against a sloping face (issue 17): a 2D trapezoid of soil
+// whose upstream face rises from (0, 0) to (0.5, 1), the skeleton fixed,
+// gravity; the nodes on and beyond the face take p = gamma_w (h - y), a
+// formula in y, with the water level h = 1.2 m above the crest; the other
+// faces are impermeable. At rest the whole body is hydrostatic, p =
+// gamma_w (h - y), with no flow: exact (linear in y, which the linear
+// shape functions interpolate exactly), asserted at 1e-6 of gamma_w h.
+TEST(HydraulicBoundaries, ReservoirHeadOnASlopingFaceIsHydrostaticAtRest) {
+  const double h = 1.2;
+  hmpm::Problem p;
+  p.dimension = 2;
+  p.grid.max = {1.0, 1.0, 0.0};
+  p.grid.cells = {10, 10, 1};
+  hmpm::Body body;
+  body.polygon = hmpm::Polygon{{{0.0, 0.0}, {1.0, 0.0}, {1.0, 1.0}, {0.5, 1.0}}};
+  body.particles_per_cell = 2;
+  p.bodies.push_back(body);
+  const double kf = 300e6, k = 1e-3;
+  p.materials.push_back(problems::saturated_elastic(2650, 1e7, 0.3, 0.3, k, kf));
+  hmpm::Boundary fixed;
+  fixed.nodes.all = true;
+  fixed.has_velocity = true;
+  for (int a = 0; a < 2; ++a) fixed.velocity[a] = problems::constant(0.0);
+  p.boundaries.push_back(fixed);
+  hmpm::Boundary reservoir;  // the nodes on the face and upstream of it
+  reservoir.nodes.polygon = hmpm::Polygon{{{0.0, 0.0}, {0.5, 1.0}, {0.0, 1.0}}};
+  reservoir.pore_pressure = [h](double) { return gamma_w * h; };
+  reservoir.pore_pressure_field = [h](const hmpm::Vec3& x, double) { return gamma_w * (h - x[1]); };
+  p.boundaries.push_back(reservoir);
+  p.gravity = {0.0, -9.81, 0.0};
+  const double c = k / (gamma_w * (0.3 / kf));
+  p.time.end = 8.0 / c;  // (1 m)^2 / c times 8: every mode has decayed (as above)
+  const auto n = hmpm::count_particles(p);
+  for (std::int64_t i = 0; i < n; ++i) p.output.series_particles.push_back(i);
+  p.output.series_fields = {hmpm::Field::pore_pressure, hmpm::Field::darcy_velocity};
+  p.output.series_interval = p.time.end;
+  const hmpm::RunResult r = hmpm::run(p);
+  ASSERT_EQ(r.status, hmpm::RunStatus::successful) << r.message;
+  const hmpm::Series& s = r.series;
+  const std::size_t last = s.time.size() - 1, np = s.particles.size();
+  ASSERT_GT(np, 100u);
+  for (std::size_t i = 0; i < np; ++i) {
+    const double y = s.initial_positions[i][1];
+    EXPECT_NEAR(s.values[0][last * np + i], gamma_w * (h - y), 1e-6 * gamma_w * h) << i;
+    for (int a = 0; a < 2; ++a)
+      EXPECT_NEAR(s.values[1][(last * np + i) * 2 + a], 0.0, 1e-6 * k) << i;
+  }
 }
 
 // What the checks refuse, with the JSON path of the entry.

@@ -112,7 +112,12 @@ void read_boundary(ParseContext& c, const json& j, const std::string& path) {
       r.error(fp, "needs 'velocity' with the wall-normal component prescribed and the others null");
   }
   if (j.contains("pore_pressure")) {
-    b.pore_pressure = read_value_of_time(c, j["pore_pressure"], path + "/pore_pressure");
+    // A number or a formula in x, y, z, t: one in t alone is a value of time.
+    bool varies = false;
+    if (auto f = read_value_of_space_time(c, j["pore_pressure"], path + "/pore_pressure", varies)) {
+      b.pore_pressure = [f = *f](double t) { return f(Vec3{0.0, 0.0, 0.0}, t); };
+      if (varies) b.pore_pressure_field = std::move(*f);
+    }
     if (!c.any_pore_pressure_bc) c.first_pore_pressure_bc = path + "/pore_pressure";
     c.any_pore_pressure_bc = true;
   }

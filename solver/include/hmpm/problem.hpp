@@ -169,6 +169,11 @@ struct Boundary {
   std::array<std::optional<FieldOfTime>, 3> velocity;
   bool has_velocity = false;  ///< any velocity component prescribed
   std::optional<FieldOfTime> pore_pressure;
+  /// When set, the prescribed pore pressure varies along the face: each
+  /// node takes pore_pressure_field(its position, t) (a reservoir, p =
+  /// gamma_w (h(t) - y)); `pore_pressure` must then be set too (the value
+  /// at the origin: the checks of formulas use it).
+  FieldOfSpaceTime pore_pressure_field;
   /// Axes along which the selected nodes move as one rigid, frictionless
   /// plate: each step their momenta and forces are summed, so they share one
   /// velocity component (Mandel's plates). A velocity prescribed on the same

@@ -186,20 +186,17 @@ inline void apply_remap_constraints(Constraints& c, GridState<Dim>& grid, double
 /// Prescribed nodal pore pressure at time t.
 template <int Dim>
 inline void apply_pressure_constraints(const Constraints& c, GridState<Dim>& grid, double t) {
-  for (const PressureConstraint& bc : c.pressure) {
-    const double value = (*bc.fn)(t);
-    for (std::int64_t i : bc.nodes) grid.pressure[i] = value;
-  }
+  for (const PressureConstraint& bc : c.pressure)
+    bc.for_values(t, [&](std::int64_t i, double value) { grid.pressure[i] = value; });
 }
 
 /// Prescribed nodes' pressure increment: to their value at t_new.
 template <int Dim>
 inline void apply_pressure_increment_constraints(const Constraints& c, GridState<Dim>& grid,
                                                  double t_new) {
-  for (const PressureConstraint& bc : c.pressure) {
-    const double value = (*bc.fn)(t_new);
-    for (std::int64_t i : bc.nodes) grid.dp[i] = value - grid.pressure[i];
-  }
+  for (const PressureConstraint& bc : c.pressure)
+    bc.for_values(t_new,
+                  [&](std::int64_t i, double value) { grid.dp[i] = value - grid.pressure[i]; });
 }
 
 /// Seepage faces on the nodal pressure at the start of a step: a face node

@@ -45,10 +45,24 @@ struct RigidTie {
   std::array<double, 3> remapped{0.0, 0.0, 0.0};  ///< scratch: tied re-mapped velocity
 };
 
-/// Pore pressure prescribed at a set of nodes.
+/// Pore pressure prescribed at a set of nodes: fn(t), or, when `field` is
+/// set, field(x[k], t) at nodes[k].
 struct PressureConstraint {
   std::vector<std::int64_t> nodes;
   const FieldOfTime* fn = nullptr;
+  const FieldOfSpaceTime* field = nullptr;
+  std::vector<Vec3> x;  ///< node positions (only with `field`)
+
+  /// Calls set(node, value) for every node at time t.
+  template <class Set>
+  void for_values(double t, Set&& set) const {
+    if (field) {
+      for (std::size_t k = 0; k < nodes.size(); ++k) set(nodes[k], (*field)(x[k], t));
+      return;
+    }
+    const double value = (*fn)(t);
+    for (std::int64_t i : nodes) set(i, value);
+  }
 };
 
 /// Seepage face nodes (Boundary::seepage), less those whose pore pressure
@@ -113,7 +127,14 @@ Constraints compile_constraints(const Problem& problem, const GridState<Dim>& gr
     }
     if (b.rigid[0] || b.rigid[1] || b.rigid[2]) c.rigid_ties.push_back({nodes, b.rigid});
     if (b.seepage && fluid) c.seepage.push_back({nodes});
-    if (b.pore_pressure && fluid) c.pressure.push_back({std::move(nodes), &*b.pore_pressure});
+    if (b.pore_pressure && fluid) {
+      PressureConstraint pc{std::move(nodes), &*b.pore_pressure, nullptr, {}};
+      if (b.pore_pressure_field) {
+        pc.field = &b.pore_pressure_field;
+        for (std::int64_t i : pc.nodes) pc.x.push_back(detail::node_position3(grid, i));
+      }
+      c.pressure.push_back(std::move(pc));
+    }
   }
   if (!fluid) return c;
   if (!c.seepage.empty()) {

@@ -347,10 +347,8 @@ class QuasiStaticScheme final : public TimeScheme {
           for (std::int64_t i : bc.nodes) du_[static_cast<std::size_t>(i) * Dim + a] = d;
         }
     for (std::size_t i = 0; i < nodes; ++i) p_[i] = pn_[i];
-    for (const PressureConstraint& bc : sim_.constraints_.pressure) {
-      const double v = (*bc.fn)(t + h);
-      for (std::int64_t i : bc.nodes) p_[static_cast<std::size_t>(i)] = v;
-    }
+    for (const PressureConstraint& bc : sim_.constraints_.pressure)
+      bc.for_values(t + h, [&](std::int64_t i, double v) { p_[static_cast<std::size_t>(i)] = v; });
     // External nodal forces at t + h: tractions (gravity is per particle).
     for (std::size_t i = 0; i < nodes; ++i) grid.force[i].setZero();
     apply_dead_loads(t + h);
