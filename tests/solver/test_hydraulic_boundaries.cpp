@@ -302,6 +302,7 @@ TEST(HydraulicBoundaries, ChecksNameTheEntryAndWhatToChange) {
   p.time.scheme = hmpm::Scheme::semi_implicit;
   const auto issues = hmpm::check_problem(p);
   std::vector<std::string> at;
+  at.reserve(issues.size());
   for (const auto& i : issues) at.push_back(i.where.text() + ": " + i.message);
   ASSERT_EQ(at.size(), 2u) << ::testing::PrintToString(at);
   EXPECT_NE(at[0].find("boundaries/1/seepage: cannot share an entry with pore_pressure"),
