@@ -387,8 +387,11 @@ void check_slopes(const Problem& p, const std::vector<BodyLayout>& layouts,
       if (!near) near.emplace(p);
       if (open_points(p, *near, f, spacing) < 3) continue;
       steepest = angle;
-      where = "(" + fmt(f.a[0]) + ", " + fmt(f.a[1]) + ") to (" + fmt(f.b[0]) + ", " + fmt(f.b[1]) +
-              ")";
+      // Appended piece by piece: GCC 12 warns (-Wrestrict, a false positive)
+      // on "(" + std::string here.
+      where.assign(1, '(');
+      where.append(fmt(f.a[0])).append(", ").append(fmt(f.a[1])).append(") to (");
+      where.append(fmt(f.b[0])).append(", ").append(fmt(f.b[1])).append(")");
     }
     if (steepest < 0) continue;
     out.push_back(
