@@ -91,18 +91,13 @@ constexpr UsualRange porosity_range{
     "hardly suits",
     "likely a void ratio e given for the porosity (n = e/(1+e): e = 1 is n = 0.5)"};
 
-/// The spec value times these factors lands in the range: the likely fix.
+/// The value times 1e3, 1e6, 1e-3 or 1e-6 (the first that lands in the
+/// range): the likely fix of a unit slip; "" when none does.
 std::string rescaled(double v, const UsualRange& r) {
   static constexpr double factors[] = {1e3, 1e6, 1e-3, 1e-6};
-  std::string out;
-  for (double f : factors) {
-    const double w = v * f;
-    if (w >= r.lo && w <= r.hi) {
-      out += (out.empty() ? "" : " or ") + fmt(w);
-      break;
-    }
-  }
-  return out;
+  for (double f : factors)
+    if (const double w = v * f; w >= r.lo && w <= r.hi) return fmt(w);
+  return {};
 }
 
 void check_range(double v, const UsualRange& r, const Location& where,

@@ -24,9 +24,9 @@ std::vector<ProblemIssue> material_plausibility(const Problem& problem);
 /// than its friction angle under gravity (2D only).
 std::vector<ProblemIssue> stability_plausibility(const Problem& problem);
 
-/// The strip bearing capacity of a surface footing of width b (m) on a
-/// weightless-surcharge-free half space of cohesion c (Pa), friction angle
-/// phi (degrees) and unit weight gamma (N/m^3): c Nc + gamma b N_gamma / 2,
+/// The strip bearing capacity of a surface footing (no surcharge) of width
+/// b (m) on a half space of cohesion c (Pa), friction angle phi (degrees)
+/// and unit weight gamma (N/m^3): c Nc + gamma b N_gamma / 2,
 /// Nq = e^(pi tan phi) tan^2(45 + phi/2), Nc = (Nq - 1) cot phi (pi + 2 at
 /// phi = 0), N_gamma = 2 (Nq + 1) tan phi (Vesic). Pa.
 double strip_bearing_capacity(double c, double phi_deg, double gamma, double b);
