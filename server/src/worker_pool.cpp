@@ -590,6 +590,7 @@ void WorkerPool::run_one(const JobRecord& job, Running& running) {
     try {
       std::filesystem::create_directories(out);
       result = hmpm::api::run_job(*parsed.job, out, options);
+      for (const std::string& w : result.run.run_warnings) append_run_log(dir, "warning: " + w);
       if (result.run.status == hmpm::RunStatus::successful) {
         outcome = JobStatus::successful;
       } else {

@@ -44,7 +44,8 @@ void Simulation<Dim, Shape>::fail_nonfinite(std::size_t p, const char* what) {
   if (!warnings_.empty())
     hint +=
         "; see the warnings: a material is where the u-p equations with Darcy's rho_f a "
-        "term grow (stiffer fluid_bulk_modulus or hydraulic.darcy_inertia = false)";
+        "term grow (that warning says what to change; hydraulic.darcy_inertia = false always "
+        "removes it)";
   record_failure(p, std::string("the ") + what + " became non-finite: the run diverged",
                  std::move(hint));
 }

@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <map>
 
 #include "hmpm/format.hpp"
 #include "interrupt.hpp"
@@ -212,6 +214,69 @@ GeostaticState geostatic_state(const Problem& problem, const SetupInterrupt* int
       out.horizontal[p] = k0 * out.vertical[p];
     }
   }
+  return out;
+}
+
+std::vector<ProblemIssue> geostatic_warnings(const Problem& problem) {
+  std::vector<ProblemIssue> out;
+  if (!problem.initial_state.geostatic || problem.dimension < 2) return out;
+  const Vertical v = vertical_of(problem);
+  if (v.axis < 0) return out;  // check_geostatic refuses it
+  // The ground surface over each column of particles: the highest particle
+  // plus half its spacing along the vertical.
+  const std::vector<BodyLayout> layouts = body_layouts(problem);
+  const double hv =
+      (problem.grid.max[v.axis] - problem.grid.min[v.axis]) / problem.grid.cells[v.axis];
+  double quantum = std::numeric_limits<double>::infinity();
+  for (int a = 0; a < problem.dimension; ++a)
+    if (a != v.axis)
+      quantum = std::min(
+          quantum, 1e-6 * (problem.grid.max[a] - problem.grid.min[a]) / problem.grid.cells[a]);
+  struct Column {
+    double surface;
+    Vec3 at;
+  };
+  std::map<std::array<std::int64_t, 2>, Column> columns;
+  double tolerance = 0;
+  for (std::size_t b = 0; b < layouts.size(); ++b) {
+    const double half = 0.5 * hv / std::max(problem.bodies[b].particles_per_cell, 1);
+    tolerance = std::max(tolerance, 2 * half);
+    for (const Vec3& x : layouts[b].positions) {
+      std::array<std::int64_t, 2> key{0, 0};
+      int k = 0;
+      for (int a = 0; a < problem.dimension; ++a)
+        if (a != v.axis) key[k++] = static_cast<std::int64_t>(std::llround(x[a] / quantum));
+      const double top = v.up * x[v.axis] + half;
+      auto [it, fresh] = columns.try_emplace(key, Column{top, x});
+      if (!fresh && top > it->second.surface) it->second = {top, x};
+    }
+  }
+  if (columns.empty()) return out;
+  auto [low, high] = std::minmax_element(
+      columns.begin(), columns.end(),
+      [](const auto& a, const auto& b) { return a.second.surface < b.second.surface; });
+  if (high->second.surface - low->second.surface <= tolerance * (1 + 1e-9)) return out;
+  const char* axis_name[] = {"x", "y", "z"};
+  auto column_text = [&](const Column& c) {
+    std::string s;
+    for (int a = 0; a < problem.dimension; ++a)
+      if (a != v.axis)
+        s += std::string(s.empty() ? "" : ", ") + axis_name[a] + " = " + fmt(c.at[a]);
+    return std::string(axis_name[v.axis]) + " = " + fmt(v.up * c.surface) + " (over " + s + ")";
+  };
+  out.push_back(
+      {{"initial_state", "geostatic"},
+       "is for level, horizontally layered ground, but the ground surface here is not level: "
+       "it lies between " +
+           column_text(low->second) + " and " + column_text(high->second) +
+           ". The geostatic state is the weight of the column above each particle with no shear "
+           "stress (and the columns of polygon or prism bodies are taken up to the top of their "
+           "bounding box), which is not in equilibrium under a slope, an embankment or a step: "
+           "as the run starts the stress redistributes and the pore pressure changes with it "
+           "before any load acts. What to change: for non-level ground, build the initial state "
+           "by gravity loading instead (omit initial_state.geostatic and settle the bodies under "
+           "gravity with local_damping over a first part of the run, loads starting after it); "
+           "for ground meant to be level, make the bodies' tops meet at one height"});
   return out;
 }
 

@@ -33,6 +33,11 @@ struct GeostaticState {
 /// the ground surface. Empty when there is no geostatic block.
 std::vector<ProblemIssue> check_geostatic(const Problem& problem);
 
+/// What makes a geostatic state (valid by check_geostatic) start away from
+/// rest: a ground surface that is not level (the particles' columns end at
+/// heights more than a particle spacing apart). Empty without a geostatic block.
+std::vector<ProblemIssue> geostatic_warnings(const Problem& problem);
+
 /// The state at every particle. Requires check_geostatic(problem) to be empty.
 /// `interrupt`, when given, is polled once per particle (set-up's stop checks).
 GeostaticState geostatic_state(const Problem& problem, const SetupInterrupt* interrupt = nullptr);

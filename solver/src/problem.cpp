@@ -14,6 +14,7 @@
 #include "hmpm/run.hpp"
 #include "materials/material.hpp"
 #include "particle_layout.hpp"
+#include "plausibility.hpp"
 #include "schemes/time_scheme.hpp"
 
 namespace hmpm {
@@ -473,6 +474,40 @@ void check_body_shape(const Problem& problem, const Body& body, const Location& 
 
 }  // namespace
 
+namespace {
+
+/// The ways out of the Darcy-inertia growth regime that exist for this
+/// material (E_oed Q rho_f/(rho - rho_f) <= 0.9): a stiffer fluid only when
+/// one no stiffer than water gets there, else a softer skeleton.
+std::string darcy_growth_advice(const Material& m, const MaterialConstants& c) {
+  constexpr double water_bulk_modulus = 2.2e9;  // Pa, at 20 degrees C
+  const Hydraulic& h = *m.hydraulic;
+  const double buoyant = c.mixture_density - c.fluid_density;
+  // The storage Q at which the ratio is 0.9, and the fluid modulus giving it.
+  const double q_target = 0.9 * buoyant / (c.fluid_density * c.constrained_modulus);
+  const double solid_term =
+      std::isinf(h.solid_bulk_modulus) ? 0.0 : (1 - h.porosity) / h.solid_bulk_modulus;
+  std::string out;
+  if (q_target > solid_term) {
+    const double kf = h.porosity / (q_target - solid_term);
+    if (kf <= water_bulk_modulus)
+      out = "a stiffer fluid_bulk_modulus (at least " + format_lower_bound(kf) +
+            " Pa; water's is 2.2e9), ";
+  }
+  // The Young's modulus at which E_oed Q gives 0.9 with the fluid as given.
+  const double nu = m.poisson_ratio;
+  const double e_target =
+      0.9 * buoyant / (c.fluid_density * c.storage) * (1 + nu) * (1 - 2 * nu) / (1 - nu);
+  if (out.empty())
+    out =
+        "no fluid_bulk_modulus up to water's 2.2e9 Pa removes it (the skeleton is stiffer "
+        "than the fluid's storage allows); a softer skeleton (youngs_modulus at most " +
+        format_upper_bound(e_target) + " Pa, if " + fmt(m.youngs_modulus) + " Pa is a unit slip), ";
+  return out + "local_damping for quasi-static runs, or darcy_inertia: false (drops the term)";
+}
+
+}  // namespace
+
 std::vector<ProblemIssue> problem_warnings(const Problem& problem) {
   std::vector<ProblemIssue> warnings;
   for (const Material& m : problem.materials) {
@@ -493,9 +528,8 @@ std::vector<ProblemIssue> problem_warnings(const Problem& problem) {
                   ") is " + fmt(growth) +
                   " times (rho - rho_f)/rho_f, above which the u-p equations with the rho_f a "
                   "term of Darcy's law have growing solutions (near it, waves hardly decay): "
-                  "oscillations can grow and the run can diverge. What to change: a stiffer "
-                  "fluid_bulk_modulus, local_damping for quasi-static runs, or darcy_inertia: "
-                  "false (drops the term)";
+                  "oscillations can grow and the run can diverge. What to change: " +
+                  darcy_growth_advice(m, c);
     warnings.push_back({Location{"materials", m.name, "hydraulic"}, what});
   }
   const std::vector<BodyLayout> layouts = body_layouts(problem);
@@ -508,7 +542,13 @@ std::vector<ProblemIssue> problem_warnings(const Problem& problem) {
                ", which is listed first, so they belong to body " + std::to_string(earlier) +
                " (a place inside several bodies gets one particle, of the first). What to "
                "change: nothing if intended; else shrink body " +
-               std::to_string(b) + " or list it first"});
+               std::to_string(b) + " (or body " + std::to_string(earlier) +
+               ") so that they do not overlap, or list body " + std::to_string(b) +
+               " first if the shared place should be its (body " + std::to_string(earlier) +
+               " then loses it)"});
+  for (ProblemIssue& w : material_plausibility(problem)) warnings.push_back(std::move(w));
+  for (ProblemIssue& w : stability_plausibility(problem)) warnings.push_back(std::move(w));
+  for (ProblemIssue& w : geostatic_warnings(problem)) warnings.push_back(std::move(w));
   return warnings;
 }
 

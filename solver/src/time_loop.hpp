@@ -19,6 +19,7 @@
 
 #include "checkpoint.hpp"
 #include "output.hpp"
+#include "run_watch.hpp"
 #include "schemes/explicit_scheme.hpp"
 #include "schemes/quasi_static_scheme.hpp"
 #include "schemes/semi_implicit_scheme.hpp"
@@ -192,6 +193,11 @@ RunResult Simulation<Dim, Shape>::run(const RunOptions& options) {
     options.on_progress(pr);
   };
 
+  // Plausibility of the state (run_watch.hpp): about 500 checks per run.
+  RunWatch<Dim> watch(problem_, constants_);
+  const std::int64_t watch_stride = std::max<std::int64_t>(1, total / 500);
+  std::int64_t watched = -1;  // the step count at the last check
+
   result.status = RunStatus::successful;
   for (; fixed ? n < total : t < end; ++n) {
     if (options.cancel && options.cancel->load(std::memory_order_relaxed)) {
@@ -233,6 +239,10 @@ RunResult Simulation<Dim, Shape>::run(const RunOptions& options) {
       break;
     }
     t = t_new;
+    if (watch.active() && (n + 1) % watch_stride == 0) {
+      watch.check(particles_, t);
+      watched = n + 1;
+    }
     if (want_series && (out.series_interval <= 0 || t >= next_series - eps_t)) {
       sample_series(series, t);
       if (out.series_interval > 0)
@@ -267,6 +277,11 @@ RunResult Simulation<Dim, Shape>::run(const RunOptions& options) {
   }
   const double seconds =
       seconds_before + std::chrono::duration<double>(Clock::now() - start).count();
+  if (watch.active() && result.status == RunStatus::successful && watched != n)
+    watch.check(particles_, t);  // the end state
+  result.run_warnings = watch.messages();
+  result.warnings.insert(result.warnings.end(), result.run_warnings.begin(),
+                         result.run_warnings.end());
   time_scheme.report(result);
   result.steps = n;
   result.end_time = t;

@@ -24,7 +24,7 @@ using json = nlohmann::json;  // NOLINT(readability-identifier-naming): nlohmann
 
 json base_spec() {
   return json::parse(R"json({"dimension": 1, "grid": {"min": [0], "max": [1], "cells": [10]},
-    "materials": {"m": {"model": "linear_elastic", "density": 1, "youngs_modulus": 1, "poisson_ratio": 0}},
+    "materials": {"m": {"model": "linear_elastic", "density": 2000, "youngs_modulus": 2e6, "poisson_ratio": 0}},
     "bodies": [{"material": "m", "box": {"min": [0], "max": [1]}}], "time": {"end": 1}})json");
 }
 
@@ -335,7 +335,7 @@ TEST(SchemeCosts, WavesOfADrySkeletonAreRefusedWithoutAnotherScheme) {
   // to remove), and 0.5 s is only 50 crossings of the wave, so the run is
   // dynamic: no scheme helps. 1e6 cells: dt = 0.5 1e-6 / 100 = 5e-9 s.
   json spec = base_spec();
-  spec["materials"]["m"]["youngs_modulus"] = 1e4;
+  spec["materials"]["m"]["youngs_modulus"] = 2e7;  // with 2000 kg/m3
   spec["grid"]["cells"] = {1000000};
   spec["bodies"][0]["particles_per_cell"] = 1;
   spec["time"]["end"] = 0.5;

@@ -161,7 +161,9 @@ class CliTest(LiveServerCase):
         self.assertEqual(r.returncode, 0, r.stderr)
         doc = json.loads(r.stdout)
         self.assertEqual(doc["jobID"], job_id)
-        self.assertEqual(doc["warnings"], [])
+        # The non-dimensional bar's two plausibility warnings (docs/job-spec.md).
+        self.assertEqual([w["path"] for w in doc["warnings"]],
+                         ["/materials/bar/youngs_modulus", "/materials/bar/density"])
         r = self.cli("log", job_id[:8])
         self.assertEqual(r.returncode, 0, r.stderr)
         self.assertIn("successful after", r.stdout)

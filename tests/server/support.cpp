@@ -25,8 +25,8 @@ std::string small_spec(const std::string& name, double end_s) {
                {"materials",
                 {{"bar",
                   {{"model", "linear_elastic"},
-                   {"density", 1.0},
-                   {"youngs_modulus", 10.0},
+                   {"density", 2000.0},  // plausible values: no warnings (docs/job-spec.md)
+                   {"youngs_modulus", 1.0e5},
                    {"poisson_ratio", 0.0}}}}},
                {"bodies", Json::array({{{"material", "bar"},
                                         {"box", {{"min", {0.0}}, {"max", {1.0}}}},

@@ -204,7 +204,7 @@ TEST_F(RoutesTest, SubmitPollAndDownloadResults) {
 // A runnable spec with something worth knowing: the 201 carries the
 // warnings with JSON pointers, and the finished run's summary repeats them.
 // The bar made saturated with a fluid far softer than the skeleton
-// (E_oed Q = 3, 4.3 times the u-p stability limit 0.7 of docs/verification.md).
+// (E_oed Q = 3e4, far above the u-p stability limit 0.7 of docs/verification.md).
 TEST_F(RoutesTest, SubmitReturnsTheSpecWarnings) {
   start();
   Json spec = json_of(small_spec("soft-fluid", 0.05));
@@ -234,6 +234,34 @@ TEST_F(RoutesTest, SubmitReturnsTheSpecWarnings) {
   res = client_->Post("/jobs", small_spec("plain"), "application/json");
   ASSERT_TRUE(res);
   EXPECT_FALSE(json_of(res->body).contains("warnings"));
+}
+
+// A warning found during the run (pore pressure below cavitation: the bar
+// saturated, nearly impermeable and pulled at its free end) reaches the
+// job log and summary.json; the run still ends successful.
+TEST_F(RoutesTest, RunWarningsReachTheJobLogAndTheSummary) {
+  start();
+  Json spec = json_of(small_spec("pulled", 0.05));
+  spec["materials"]["bar"]["youngs_modulus"] = 1e7;
+  spec["materials"]["bar"]["density"] = 2650.0;
+  spec["materials"]["bar"]["hydraulic"] = {
+      {"porosity", 0.3}, {"hydraulic_conductivity", 1e-9}, {"fluid_bulk_modulus", 2.2e9}};
+  spec["bodies"][0].erase("initial");
+  spec["tractions"] = Json::array({{{"particles", {{"box", {{"min", {0.9}}, {"max", {1.0}}}}}},
+                                    {"face", "x+"},
+                                    {"traction", {5e5}}}});
+  spec["time"] = {{"end", 0.05}};
+  auto res = client_->Post("/jobs", spec.dump(), "application/json");
+  ASSERT_TRUE(res);
+  ASSERT_EQ(res->status, 201) << res->body;
+  const std::string id = json_of(res->body)["jobID"];
+  ASSERT_EQ(wait_final(id).value("status", ""), "successful");
+  const std::string log = client_->Get(("/jobs/" + id + "/log").c_str())->body;
+  EXPECT_NE(log.find("warning: during the run: pore pressure below cavitation"), std::string::npos)
+      << log;
+  const Json s = json_of(client_->Get(("/jobs/" + id + "/results/summary.json").c_str())->body);
+  ASSERT_FALSE(s["warnings"].empty()) << s.dump();
+  EXPECT_NE(s["warnings"].back().get<std::string>().find("below cavitation"), std::string::npos);
 }
 
 TEST_F(RoutesTest, HostileBodiesGetProblemDocumentsAndTheServerKeepsAnswering) {

@@ -59,4 +59,16 @@ inline std::string format_significant(double v, int digits) {
   return o.str();
 }
 
+/// A positive bound printed to 4 significant digits without exceeding it
+/// ("use dt <= X": X itself must pass the check): the value lowered by half
+/// a unit in the 4th digit, then rounded, is at most v.
+inline std::string format_upper_bound(double v) {
+  return format_significant(v * (1 - 5e-4), 4);
+}
+
+/// The same for a lower bound ("at least X"): printed, it is at least v.
+inline std::string format_lower_bound(double v) {
+  return format_significant(v * (1 + 5e-4), 4);
+}
+
 }  // namespace hmpm

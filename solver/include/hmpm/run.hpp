@@ -230,7 +230,12 @@ const char* status_name(RunStatus s);
 struct RunResult {
   RunStatus status = RunStatus::failed;
   std::string message;
+  /// The set-up's warnings (problem_warnings), then run_warnings.
   std::vector<std::string> warnings;
+  /// Found during the time loop (pore pressure below cavitation, tensile
+  /// total stress in a material without tensile strength), also at the end
+  /// of `warnings`: the run still ends as it ends.
+  std::vector<std::string> run_warnings;
   std::int64_t steps = 0;
   double end_time = 0.0;  ///< simulated time reached, s
   double dt = 0.0;

@@ -76,7 +76,7 @@ void check_explicit_step(const Problem& problem, const StableStep& s,
                               fmt(s.wave_speed) + " m/s";
   issues.push_back({{"time", "dt"},
                     "is " + fmt(*problem.time.dt) + " s, above the stable limit " + fmt(s.limit) +
-                        " s (" + why + "); use dt <= " + fmt(s.limit) +
+                        " s (" + why + "); use dt <= " + format_upper_bound(s.limit) +
                         " or omit dt to let the solver choose " + fmt(0.5 * s.limit) + " s"});
 }
 

@@ -57,7 +57,7 @@ void check_semi_implicit_step(const Problem& problem, const StableStep& s,
   message += " s (the skeleton's wave h/(c sqrt(d)) with drained wave speed c = sqrt(E_oed/rho) = ";
   message += fmt(s.wave_speed);
   message += " m/s); use dt <= ";
-  message += fmt(s.limit);
+  message += format_upper_bound(s.limit);
   message += ", omit dt to let the solver choose ";
   message += fmt(problem.time.courant * s.limit);
   message += " s, or use time.scheme \"quasi_static\" for a slow process without inertia";
