@@ -2,7 +2,7 @@
 //
 // Wraps hmpm::run: snapshots are written as the solver hands them over (the
 // .pvd collection is rewritten after each, so partial results are usable),
-// the series after the loop, summary.json last and always — also when the
+// the series and the reactions after the loop, summary.json last and always — also when the
 // run failed or a file could not be written (then the other files it wrote
 // are removed, so the listed files are exactly the ones left). Checkpoints
 // (options on_checkpoint) go to the caller as the solver takes them; a run
@@ -71,6 +71,18 @@ JobOutcome run_job(const ParsedJob& job, const fs::path& out_dir, const hmpm::Ru
       write_series_csv(out_dir / "series.csv", outcome.run.series);
       outcome.files.push_back("series.json");
       outcome.files.push_back("series.csv");
+    } catch (const std::runtime_error& e) {
+      write_error = e.what();
+      outcome.run.status = RunStatus::failed;
+      outcome.run.message = std::string("could not write results: ") + e.what();
+    }
+  }
+  if (out.reactions_interval > 0 && write_error.empty()) {
+    try {
+      write_reactions_json(out_dir / "reactions.json", outcome.run.reactions);
+      write_reactions_csv(out_dir / "reactions.csv", outcome.run.reactions);
+      outcome.files.push_back("reactions.json");
+      outcome.files.push_back("reactions.csv");
     } catch (const std::runtime_error& e) {
       write_error = e.what();
       outcome.run.status = RunStatus::failed;
