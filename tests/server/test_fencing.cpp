@@ -167,9 +167,10 @@ TEST(Fencing, ARevivedServerCannotChangeTheFilesOfTheAttemptThatFinished) {
     return std::chrono::system_clock::now() + std::chrono::seconds(offset_s.load());
   });
   // 20 000 steps of a 1000-particle bar: about half a second of solver work.
-  const auto submitted = store->submit(NewJob{"0f0f0f0f-0000-4000-8000-000000000001", "fenced",
-                                              long_spec("fenced", 20.0), JobCost{}, "", ""},
-                                       10);
+  const auto submitted =
+      store->submit(NewJob{"0f0f0f0f-0000-4000-8000-000000000001", "fenced",
+                           long_spec("fenced", 20.0), JobCost{}, "", ""},
+                    10);
   ASSERT_EQ(submitted.outcome, SubmitOutcome::created);
   const std::string id = submitted.job.id;
 
