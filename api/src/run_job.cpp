@@ -65,30 +65,25 @@ JobOutcome run_job(const ParsedJob& job, const fs::path& out_dir, const hmpm::Ru
   if (!snapshots.empty()) outcome.files.push_back("snapshots.pvd");
   const OutputRequest& out = job.problem.output;
   const bool series_requested = !out.series_particles.empty() && !out.series_fields.empty();
-  if (series_requested && write_error.empty()) {
+  // A pair of files (`stem`.json and `stem`.csv) of a history kept in memory.
+  auto write_history = [&](const std::string& stem, auto write_json, auto write_csv,
+                           const auto& history) {
+    if (!write_error.empty()) return;
     try {
-      write_series_json(out_dir / "series.json", outcome.run.series);
-      write_series_csv(out_dir / "series.csv", outcome.run.series);
-      outcome.files.push_back("series.json");
-      outcome.files.push_back("series.csv");
+      write_json(out_dir / (stem + ".json"), history);
+      write_csv(out_dir / (stem + ".csv"), history);
+      outcome.files.push_back(stem + ".json");
+      outcome.files.push_back(stem + ".csv");
     } catch (const std::runtime_error& e) {
       write_error = e.what();
       outcome.run.status = RunStatus::failed;
       outcome.run.message = std::string("could not write results: ") + e.what();
     }
-  }
-  if (out.reactions_interval > 0 && write_error.empty()) {
-    try {
-      write_reactions_json(out_dir / "reactions.json", outcome.run.reactions);
-      write_reactions_csv(out_dir / "reactions.csv", outcome.run.reactions);
-      outcome.files.push_back("reactions.json");
-      outcome.files.push_back("reactions.csv");
-    } catch (const std::runtime_error& e) {
-      write_error = e.what();
-      outcome.run.status = RunStatus::failed;
-      outcome.run.message = std::string("could not write results: ") + e.what();
-    }
-  }
+  };
+  if (series_requested)
+    write_history("series", write_series_json, write_series_csv, outcome.run.series);
+  if (out.reactions_interval > 0)
+    write_history("reactions", write_reactions_json, write_reactions_csv, outcome.run.reactions);
   if (!write_error.empty()) {
     // Partial results are removed: they hold the space a full disk needs,
     // and a set of snapshots without the rest is no result.

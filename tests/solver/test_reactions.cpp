@@ -179,25 +179,25 @@ TEST_P(AtRest, TheBaseCarriesTheColumnsWeightAndTheRollersNone) {
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(
-    Columns, AtRest,
-    ::testing::Values(Case{1, hmpm::Scheme::explicit_scheme, false, true},
-                      Case{2, hmpm::Scheme::explicit_scheme, false, true},
-                      Case{1, hmpm::Scheme::explicit_scheme, true, true},
-                      Case{2, hmpm::Scheme::explicit_scheme, true, true},
-                      Case{2, hmpm::Scheme::semi_implicit, false, true},
-                      Case{1, hmpm::Scheme::semi_implicit, true, true},
-                      Case{2, hmpm::Scheme::semi_implicit, true, true},
-                      Case{1, hmpm::Scheme::quasi_static, false, false},
-                      Case{2, hmpm::Scheme::quasi_static, false, false},
-                      Case{1, hmpm::Scheme::quasi_static, true, false},
-                      Case{2, hmpm::Scheme::quasi_static, true, false},
-                      Case{2, hmpm::Scheme::quasi_static, true, true}),
-    [](const auto& info) {
-      const Case& c = info.param;
-      return std::to_string(c.dim) + "D_" + hmpm::scheme_name(c.scheme) +
-             (c.saturated ? "_saturated" : "_dry") + (c.geostatic ? "_geostatic" : "");
-    });
+INSTANTIATE_TEST_SUITE_P(Columns, AtRest,
+                         ::testing::Values(Case{1, hmpm::Scheme::explicit_scheme, false, true},
+                                           Case{2, hmpm::Scheme::explicit_scheme, false, true},
+                                           Case{1, hmpm::Scheme::explicit_scheme, true, true},
+                                           Case{2, hmpm::Scheme::explicit_scheme, true, true},
+                                           Case{2, hmpm::Scheme::semi_implicit, false, true},
+                                           Case{1, hmpm::Scheme::semi_implicit, true, true},
+                                           Case{2, hmpm::Scheme::semi_implicit, true, true},
+                                           Case{1, hmpm::Scheme::quasi_static, false, false},
+                                           Case{2, hmpm::Scheme::quasi_static, false, false},
+                                           Case{1, hmpm::Scheme::quasi_static, true, false},
+                                           Case{2, hmpm::Scheme::quasi_static, true, false},
+                                           Case{2, hmpm::Scheme::quasi_static, true, true}),
+                         [](const auto& info) {
+                           const Case& c = info.param;
+                           return std::to_string(c.dim) + "D_" + hmpm::scheme_name(c.scheme) +
+                                  (c.saturated ? "_saturated" : "_dry") +
+                                  (c.geostatic ? "_geostatic" : "");
+                         });
 
 // A strip load q on the top of the column over x in [0, B]: the base carries
 // W + q B, the rollers no vertical force, and the two rollers' horizontal
@@ -273,10 +273,11 @@ TEST(Reactions, ExplicitDampedToRestUnderAStripLoad) {
   const double total = weight(c) + load;
   const std::size_t last = r.reactions.time.size() - 1;
   const double err = std::abs(force(r, 0, last, 1) - total) / total;
-  std::printf("explicit strip load at t = %g s: base %.3e of W + Q (Q = %.6g N/m, qB = %g); "
-              "first sample (t = %g s) %.3e\n",
-              r.reactions.time[last], err, load, q * b, r.reactions.time[0],
-              std::abs(force(r, 0, 0, 1) - total) / total);
+  std::printf(
+      "explicit strip load at t = %g s: base %.3e of W + Q (Q = %.6g N/m, qB = %g); "
+      "first sample (t = %g s) %.3e\n",
+      r.reactions.time[last], err, load, q * b, r.reactions.time[0],
+      std::abs(force(r, 0, 0, 1) - total) / total);
   EXPECT_LT(err, 1e-9);
   EXPECT_EQ(force(r, 1, last, 1), 0.0);
 }
