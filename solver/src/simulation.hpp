@@ -233,6 +233,8 @@ class Simulation {
     int axis;
     int boundary;     ///< index in Problem::boundaries
     bool prescribed;  ///< a prescribed velocity (else friction or a rigid tie)
+    /// Friction: the wall's flag of the node sticking this step (null otherwise).
+    const std::uint8_t* stuck;
   };
   void setup_reactions();
   /// Keeps `force` at the charged components (the semi-implicit step's

@@ -305,6 +305,38 @@ TEST(Reactions, ANodeOfTwoBoundariesIsChargedToTheLaterOne) {
   }
 }
 
+// A friction wall: an elastic block (no initial stress) against a roller at
+// x = 0, free on its right, settles under gravity on a rough floor (a
+// friction wall: vertical velocity prescribed, "rough": no slip) and is
+// damped to rest. The floor carries the weight, and its friction holds the
+// block's Poisson spreading: the floor's horizontal force balances the
+// roller's (nothing else acts horizontally). At rest (local damping 0.7
+// over 40 periods of the block, as above) both to 1e-9 of W.
+TEST(Reactions, AFrictionFloorCarriesTheWeightAndBalancesTheWall) {
+  Case c;
+  c.geostatic = false;
+  hmpm::Problem p = column(c, 2.0, 0.5);
+  p.grid.cells[0] = 6;  // room to spread on the right
+  p.grid.max[0] = 6 * h;
+  p.boundaries.resize(2);  // the base and the left roller
+  p.boundaries[0].velocity[0].reset();
+  p.boundaries[0].friction = std::numeric_limits<double>::infinity();
+  p.boundaries[0].nodes = problems::plane(p, 1, 0.0);
+  p.boundaries[1].nodes = problems::plane(p, 0, 0.0);
+  p.local_damping = problems::constant(0.7);
+  const hmpm::RunResult r = run_ok(p, "friction floor");
+  const double w = weight(c);
+  const std::size_t last = r.reactions.time.size() - 1;
+  const double floor_x = force(r, 0, last, 0), wall_x = force(r, 1, last, 0);
+  std::printf(
+      "friction floor at rest: vertical %.3e of W, horizontal floor %.4g N/m, wall %.4g N/m\n",
+      std::abs(force(r, 0, last, 1) - w) / w, floor_x, wall_x);
+  EXPECT_NEAR(force(r, 0, last, 1), w, 1e-9 * w);
+  EXPECT_NEAR(floor_x + wall_x, 0.0, 1e-9 * w);
+  EXPECT_GT(std::abs(floor_x), 1e-3 * w) << "the friction is engaged";
+  EXPECT_EQ(force(r, 1, last, 1), 0.0);
+}
+
 TEST(Reactions, NoneAskedNoneReported) {
   Case c;
   const hmpm::RunResult r = run_ok(column(c, 0.02, 0.0), "no reactions");

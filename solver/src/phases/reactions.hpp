@@ -6,14 +6,17 @@
 // physical nodal forces (internal stress and pore pressure, tractions,
 // gravity) for the node to move as the constraint makes it move. In the
 // explicit and semi-implicit steps, at a node component i, a:
-//   prescribed velocity (also a friction wall's normal):  R = m a_c - f
-//   friction (tangential) and rigid ties:                R = m a_c - f_damped
+//   prescribed velocity (also a friction wall's normal,
+//   and its tangential components where it sticks):      R = m a_c - f
+//   friction (slipping, tangential) and rigid ties:      R = m a_c - f_damped
 // with a_c the constrained nodal acceleration the particles receive, f =
 // f_int + f_p + f_traction + m g (+ the pressure increment's force in the
 // semi-implicit step) and f_damped f with the step's local damping. A
-// prescribed component replaces the free update, damping included, so
-// damping never enters its reaction; friction and ties only modify the free
-// (damped) update, so their reaction is the modification alone. The sum of
+// prescribed component (and a sticking friction node, whose tangential
+// velocity is set to the wall's) replaces the free update, damping
+// included, so damping never enters its reaction; slipping friction and ties
+// only modify the free (damped) update, so their reaction is the
+// modification alone. The sum of
 // the reactions of a rigid tie is zero (a massless plate) up to damping.
 // Because the particles' momentum changes by sum m a_c dt, the reactions,
 // the weight and the tractions balance the rate of momentum: at rest the
@@ -43,29 +46,32 @@ void Simulation<Dim, Shape>::setup_reactions() {
   const auto nodes = static_cast<std::size_t>(grid_.count);
   reaction_owner_.assign(nodes * Dim, -1);
   std::vector<std::uint8_t> prescribed(nodes * Dim, 0);
-  auto charge = [&](std::int64_t i, int a, std::size_t b, bool fixed) {
+  std::vector<const std::uint8_t*> stuck(nodes * Dim, nullptr);
+  auto charge = [&](std::int64_t i, int a, std::size_t b, bool fixed, const std::uint8_t* flag) {
     const std::size_t d = static_cast<std::size_t>(i) * Dim + static_cast<std::size_t>(a);
     reaction_owner_[d] = static_cast<int>(b);
     prescribed[d] = fixed ? 1 : 0;
+    stuck[d] = flag;
   };
   for (const RigidTie& tie : constraints_.rigid_ties)
     for (int a = 0; a < Dim; ++a)
       if (tie.axes[a])
-        for (std::int64_t i : tie.nodes) charge(i, a, tie.boundary, false);
+        for (std::int64_t i : tie.nodes) charge(i, a, tie.boundary, false, nullptr);
   for (const VelocityConstraint& bc : constraints_.velocity)
     if (bc.has_friction())
       for (int a = 0; a < Dim; ++a)
         if (a != bc.normal)
-          for (std::int64_t i : bc.nodes) charge(i, a, bc.boundary, false);
+          for (std::size_t k = 0; k < bc.nodes.size(); ++k)
+            charge(bc.nodes[k], a, bc.boundary, false, &bc.stuck[k]);
   for (const VelocityConstraint& bc : constraints_.velocity)
     for (int a = 0; a < Dim; ++a)
       if (bc.fixed[a])
-        for (std::int64_t i : bc.nodes) charge(i, a, bc.boundary, true);
+        for (std::int64_t i : bc.nodes) charge(i, a, bc.boundary, true, nullptr);
   charges_.clear();
   for (std::size_t d = 0; d < nodes * Dim; ++d)
     if (reaction_owner_[d] >= 0)
       charges_.push_back({static_cast<std::int64_t>(d / Dim), static_cast<int>(d % Dim),
-                          reaction_owner_[d], prescribed[d] != 0});
+                          reaction_owner_[d], prescribed[d] != 0, stuck[d]});
   charge_extra_.assign(charges_.size(), 0.0);
   reaction_.assign(problem_.boundaries.size(), Vec3{0.0, 0.0, 0.0});
 }
@@ -87,9 +93,10 @@ void Simulation<Dim, Shape>::tally_reactions(bool with_extra) {
     const double m = grid_.mass[i];
     const double f = grid_.force[i][a] + m * gravity_[a];
     double r = m * grid_.accel[i][a] - f;
-    if (!ch.prescribed) {
-      // The free update these components started from was damped, and a
-      // node without mass was left at rest without any constraint.
+    if (!ch.prescribed && !(ch.stuck && *ch.stuck)) {
+      // The free update these components started from was damped (a
+      // sticking friction node replaces it, as a prescribed component
+      // does), and a node without mass was left at rest unconstrained.
       if (m <= mass_tolerance_) continue;
       const double v0 = grid_.momentum[i][a] / m;
       r += alpha * std::abs(f) * (v0 > 0 ? 1.0 : (v0 < 0 ? -1.0 : 0.0));
