@@ -147,6 +147,7 @@ struct FileState {
 };
 
 // For gtest's failure messages.
+// NOLINTNEXTLINE(readability-identifier-naming): GoogleTest looks the printer up by this name.
 void PrintTo(const FileState& f, std::ostream* os) {
   *os << "{sha256 " << f.sha256 << ", inode " << f.inode << ", mtime " << f.mtime_ns << " ns}";
 }
@@ -167,10 +168,9 @@ TEST(Fencing, ARevivedServerCannotChangeTheFilesOfTheAttemptThatFinished) {
     return std::chrono::system_clock::now() + std::chrono::seconds(offset_s.load());
   });
   // 20 000 steps of a 1000-particle bar: about half a second of solver work.
-  const auto submitted =
-      store->submit(NewJob{"0f0f0f0f-0000-4000-8000-000000000001", "fenced",
-                           long_spec("fenced", 20.0), JobCost{}, "", ""},
-                    10);
+  const auto submitted = store->submit(NewJob{"0f0f0f0f-0000-4000-8000-000000000001", "fenced",
+                                              long_spec("fenced", 20.0), JobCost{}, "", ""},
+                                       10);
   ASSERT_EQ(submitted.outcome, SubmitOutcome::created);
   const std::string id = submitted.job.id;
 
