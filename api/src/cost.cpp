@@ -251,6 +251,11 @@ double memory_bytes(const Problem& p, const CostEstimate& c, double threads) {
     per_row += field_components(f, p.dimension) * static_cast<double>(o.series_particles.size());
   if (c.series_rows > 0)
     bytes += MemoryModel::growth * 8 * per_row * static_cast<double>(c.series_rows);
+  // The reactions: a time and a vector per boundary per sample.
+  if (c.reaction_rows > 0)
+    bytes += MemoryModel::growth * 8 *
+             (1.0 + static_cast<double>(p.boundaries.size() * p.dimension)) *
+             static_cast<double>(c.reaction_rows);
   // One snapshot's arrays (3 components per vector, 6 per tensor), filled
   // while the file is written.
   if (c.snapshots > 0) {
@@ -373,6 +378,10 @@ CostEstimate estimate_cost(const Problem& p, const Calibration& calibration) {
   const double snaps =
       o.snapshot_interval > 0 ? std::floor(p.time.end / o.snapshot_interval + 1e-9) + 1 : 0;
   c.snapshots = to_count(snaps);
+  const double reaction_rows =
+      o.reactions_interval > 0 ? std::floor(p.time.end / o.reactions_interval + 1e-9) : 0;
+  c.reaction_rows = to_count(reaction_rows);
+  const double reaction_values = static_cast<double>(p.boundaries.size()) * dim;
   double series_values = 0;
   for (Field f : o.series_fields) series_values += field_components(f, dim);
   series_values *= static_cast<double>(o.series_particles.size());
@@ -386,7 +395,7 @@ CostEstimate estimate_cost(const Problem& p, const Calibration& calibration) {
   // ~22 characters per number in series.json and again in series.csv;
   // base64 float64 in the VTU files is 8 * 4/3 bytes per number.
   const double bytes =
-      4096 + rows * (1 + series_values) * 2 * 22 +
+      4096 + rows * (1 + series_values) * 2 * 22 + reaction_rows * (1 + reaction_values) * 2 * 22 +
       snaps * (static_cast<double>(c.particles) * (snapshot_values * 32.0 / 3.0 + 16) + 4096);
   c.output_bytes = to_count(bytes);
   const double threads = solver_threads(static_cast<double>(c.particles), calibration.threads);

@@ -2,7 +2,7 @@
 //
 // Wraps hmpm::run: snapshots are written as the solver hands them over (the
 // .pvd collection is rewritten after each, so partial results are usable),
-// the series after the loop, summary.json last and always — also when the
+// the series and the reactions after the loop, summary.json last and always — also when the
 // run failed or a file could not be written (then the other files it wrote
 // are removed, so the listed files are exactly the ones left). Checkpoints
 // (options on_checkpoint) go to the caller as the solver takes them; a run
@@ -65,18 +65,25 @@ JobOutcome run_job(const ParsedJob& job, const fs::path& out_dir, const hmpm::Ru
   if (!snapshots.empty()) outcome.files.push_back("snapshots.pvd");
   const OutputRequest& out = job.problem.output;
   const bool series_requested = !out.series_particles.empty() && !out.series_fields.empty();
-  if (series_requested && write_error.empty()) {
+  // A pair of files (`stem`.json and `stem`.csv) of a history kept in memory.
+  auto write_history = [&](const std::string& stem, auto write_json, auto write_csv,
+                           const auto& history) {
+    if (!write_error.empty()) return;
     try {
-      write_series_json(out_dir / "series.json", outcome.run.series);
-      write_series_csv(out_dir / "series.csv", outcome.run.series);
-      outcome.files.push_back("series.json");
-      outcome.files.push_back("series.csv");
+      write_json(out_dir / (stem + ".json"), history);
+      write_csv(out_dir / (stem + ".csv"), history);
+      outcome.files.push_back(stem + ".json");
+      outcome.files.push_back(stem + ".csv");
     } catch (const std::runtime_error& e) {
       write_error = e.what();
       outcome.run.status = RunStatus::failed;
       outcome.run.message = std::string("could not write results: ") + e.what();
     }
-  }
+  };
+  if (series_requested)
+    write_history("series", write_series_json, write_series_csv, outcome.run.series);
+  if (out.reactions_interval > 0)
+    write_history("reactions", write_reactions_json, write_reactions_csv, outcome.run.reactions);
   if (!write_error.empty()) {
     // Partial results are removed: they hold the space a full disk needs,
     // and a set of snapshots without the rest is no result.

@@ -49,6 +49,13 @@ void write_series_json(const std::filesystem::path& path, const Series& series);
 /// series.csv: header "time,p<index>_<field>[_<component>],..."; one row per time.
 void write_series_csv(const std::filesystem::path& path, const Series& series);
 
+/// reactions.json: {"time": [...], "boundaries": [{"index": i, "force": [[fx, ...], ...]}]},
+/// one vector of `dimension` components per time for every boundary.
+void write_reactions_json(const std::filesystem::path& path, const Reactions& reactions);
+
+/// reactions.csv: header "time,b<index>_force_<x|y|z>,..."; one row per time.
+void write_reactions_csv(const std::filesystem::path& path, const Reactions& reactions);
+
 /// One snapshot as a VTK UnstructuredGrid (.vtu): one vertex cell per
 /// particle, Points = positions, PointData = the snapshot's fields plus
 /// volume and material; base64-encoded little-endian binary, uncompressed.

@@ -21,6 +21,7 @@ std::uint64_t fingerprint(const Problem& problem, const std::string& key) {
   mix(count_particles(problem));
   mix(problem.output.series_interval);
   mix(problem.output.snapshot_interval);
+  mix(problem.output.reactions_interval);
   return h;
 }
 
@@ -38,6 +39,7 @@ void write_header(Writer& w, const Header& h) {
   w.pod(h.total);
   w.pod(h.next_series);
   w.pod(h.next_snapshot);
+  w.pod(h.next_reaction);
   w.pod(h.seconds);
   w.array(h.snapshot_times);
 }
@@ -69,6 +71,7 @@ Header read_header(Reader& r, const std::string& bytes, const Problem& problem,
   h.total = r.pod<std::int64_t>();
   h.next_series = r.pod<double>();
   h.next_snapshot = r.pod<double>();
+  h.next_reaction = r.pod<double>();
   h.seconds = r.pod<double>();
   r.array(h.snapshot_times, -1, "snapshot list");
   auto refuse = [](const std::string& what) {

@@ -10,9 +10,11 @@
 //            RunOptions::checkpoint_key and the problem's set-up figures),
 //            i32 threads, i64 step, f64 time
 //   loop     i64 total steps (estimate), f64 next series time, f64 next
-//            snapshot time, f64 loop wall seconds so far, array of the
-//            snapshot times taken
+//            snapshot time, f64 next reaction time, f64 loop wall seconds so
+//            far, array of the snapshot times taken
 //   series   array of sample times, u64 field count, one array per field
+//   reactions  array of sample times, u64 boundary count (0 when none are
+//            asked for), one array per boundary
 //   particles  every array of ParticleState::for_each_array, in its order
 //   scheme   TimeScheme::save (e.g. the semi-implicit solver's initial
 //            guess, the quasi-static step plan and counters)
@@ -35,7 +37,7 @@
 namespace hmpm::checkpoint {
 
 inline constexpr char magic[8] = {'H', 'M', 'P', 'M', 'C', 'K', 'P', 'T'};
-inline constexpr std::uint32_t version = 1;
+inline constexpr std::uint32_t version = 2;  ///< 2: reactions
 
 /// FNV-1a, 64 bits, continuing from `h`.
 inline std::uint64_t fnv1a(const char* data, std::size_t n,
@@ -119,7 +121,7 @@ struct Header {
   std::int64_t step = 0;
   double time = 0.0;
   std::int64_t total = 0;
-  double next_series = 0.0, next_snapshot = 0.0;
+  double next_series = 0.0, next_snapshot = 0.0, next_reaction = 0.0;
   double seconds = 0.0;  ///< loop wall time of the runs so far
   std::vector<double> snapshot_times;
 };

@@ -30,6 +30,7 @@ Simulation<Dim, Shape>::Simulation(const Problem& problem, const RunOptions& opt
   constraints_ = compile_constraints<Dim>(problem_, grid_, grid_max_, fluid_);
   tractions_ = compile_tractions<Dim>(problem_, particles_, grid_);
   if (fluid_) fluxes_ = compile_fluxes<Dim>(problem_, particles_, grid_);
+  if (problem_.output.reactions_interval > 0) setup_reactions();
   setup_geostatic();
   interrupt_.check();
 }

@@ -229,6 +229,24 @@ class Simulation {
   bool loads_finite_at(double t);
   static std::string number(double v);
 
+  // ------------------------------------------------------------ reactions (phases/reactions.hpp)
+  /// A node component whose constraint force is charged to a boundary.
+  struct ReactionCharge {
+    std::int64_t node;
+    int axis;
+    int boundary;     ///< index in Problem::boundaries
+    bool prescribed;  ///< a prescribed velocity (else friction or a rigid tie)
+    /// Friction: the wall's flag of the node sticking this step (null otherwise).
+    const std::uint8_t* stuck;
+  };
+  void setup_reactions();
+  /// Keeps `force` at the charged components (the semi-implicit step's
+  /// pressure-increment force, gone from the grid by the time of the tally).
+  void record_reaction_extra_force(const std::vector<Vec>& force);
+  /// reaction_ from the constrained nodal accelerations of this step; with
+  /// the forces record_reaction_extra_force kept, when `with_extra`.
+  void tally_reactions(bool with_extra);
+
   // ------------------------------------------------------------ output (output.hpp)
   void fill_snapshot(Snapshot& snap, const std::vector<Field>& fields) const;
   void sample_series(Series& series, double t) const;
@@ -242,6 +260,15 @@ class Simulation {
   Constraints constraints_;
   std::vector<TractionLoad> tractions_;
   std::vector<FluxLoad> fluxes_;  ///< saturated runs only
+  // Reactions (set up only when the output asks for them): per node
+  // component the boundary charged with it (-1: none), the charged
+  // components, a force kept per charge, the step's force of each boundary,
+  // and whether the time loop samples the current step.
+  std::vector<int> reaction_owner_;
+  std::vector<ReactionCharge> charges_;
+  std::vector<double> charge_extra_;
+  std::vector<Vec3> reaction_;
+  bool reactions_due_ = false;
   Vec gravity_ = Vec::Zero();
   Vec grid_max_ = Vec::Zero();
   bool fluid_ = false;

@@ -9,6 +9,7 @@
 #include "phases/particle_to_grid.hpp"
 #include "phases/pore_pressure.hpp"
 #include "phases/pressure_projection.hpp"
+#include "phases/reactions.hpp"
 #include "phases/stress_and_flux.hpp"
 #include "schemes/explicit_scheme.hpp"
 #include "schemes/semi_implicit_scheme.hpp"

@@ -93,6 +93,13 @@ RunResult Simulation<Dim, Shape>::run(const RunOptions& options) {
       series.initial_positions.push_back(x0);
     }
   }
+  // Reactions: one vector per boundary per sample, the first at t =
+  // interval (a step's reaction needs the step).
+  Reactions& reactions = result.reactions;
+  reactions.dimension = Dim;
+  const bool want_reactions = out.reactions_interval > 0;
+  if (want_reactions) reactions.force.resize(problem_.boundaries.size());
+  double next_reaction = out.reactions_interval;
   std::vector<Field> snapshot_fields = out.snapshot_fields;
   if (snapshot_fields.empty())
     for (int f = 0; f < field_count; ++f) snapshot_fields.push_back(static_cast<Field>(f));
@@ -123,6 +130,7 @@ RunResult Simulation<Dim, Shape>::run(const RunOptions& options) {
     total = h.total;
     next_series = h.next_series;
     next_snapshot = h.next_snapshot;
+    next_reaction = h.next_reaction;
     seconds_before = h.seconds;
     snapshot_times = h.snapshot_times;
     snap.index = static_cast<int>(snapshot_times.size());
@@ -133,6 +141,13 @@ RunResult Simulation<Dim, Shape>::run(const RunOptions& options) {
                                   " fields where this run has " +
                                   std::to_string(series.values.size()));
     for (std::vector<double>& v : series.values) r.array(v, -1, "series values");
+    r.array(reactions.time, -1, "reaction times");
+    const auto boundaries = r.pod<std::uint64_t>();
+    if (boundaries != reactions.force.size())
+      throw std::invalid_argument("the checkpoint has reactions of " + std::to_string(boundaries) +
+                                  " boundaries where this run has " +
+                                  std::to_string(reactions.force.size()));
+    for (std::vector<double>& v : reactions.force) r.array(v, -1, "reactions");
     particles_.for_each_array(
         [&](auto& a) { r.array(a, static_cast<std::int64_t>(a.size()), "particle array"); });
     time_scheme.load(r);
@@ -171,12 +186,16 @@ RunResult Simulation<Dim, Shape>::run(const RunOptions& options) {
     h.total = total;
     h.next_series = next_series;
     h.next_snapshot = next_snapshot;
+    h.next_reaction = next_reaction;
     h.seconds = seconds_before + std::chrono::duration<double>(now - start).count();
     h.snapshot_times = snapshot_times;
     checkpoint::write_header(w, h);
     w.array(series.time);
     w.pod(static_cast<std::uint64_t>(series.values.size()));
     for (const std::vector<double>& v : series.values) w.array(v);
+    w.array(reactions.time);
+    w.pod(static_cast<std::uint64_t>(reactions.force.size()));
+    for (const std::vector<double>& v : reactions.force) w.array(v);
     particles_.for_each_array([&](const auto& a) { w.array(a); });
     time_scheme.save(w);
     checkpoint::finish(w);
@@ -222,6 +241,7 @@ RunResult Simulation<Dim, Shape>::run(const RunOptions& options) {
     // the step uses them (the start's was checked by the step before, or
     // below for t = 0): a NaN there is reported as the formula's, not as the
     // divergence it would cause.
+    reactions_due_ = want_reactions && t_new >= next_reaction - eps_t;
     if ((n > 0 || loads_finite_at(t)) && loads_finite_at(t_new)) time_scheme.step(t, t_new - t);
     if (failed_) {
       std::ostringstream where;
@@ -247,6 +267,12 @@ RunResult Simulation<Dim, Shape>::run(const RunOptions& options) {
       sample_series(series, t);
       if (out.series_interval > 0)
         while (next_series <= t + eps_t) next_series += out.series_interval;
+    }
+    if (reactions_due_) {
+      reactions.time.push_back(t);
+      for (std::size_t b = 0; b < reactions.force.size(); ++b)
+        for (int a = 0; a < Dim; ++a) reactions.force[b].push_back(reaction_[b][a]);
+      while (next_reaction <= t + eps_t) next_reaction += out.reactions_interval;
     }
     if (want_snapshots && t >= next_snapshot - eps_t) {
       take_snapshot(t);

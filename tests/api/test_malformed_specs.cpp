@@ -185,6 +185,13 @@ const Mutation mutations[] = {
     {"near_wrong_length", "/output/series/particles/1/near", "[0.5]",
      "/output/series/particles/1/near", "expected 2"},
     {"output_key_typo", "/output/snapshot", "{}", "/output/snapshot", "did you mean 'snapshots'?"},
+    {"reactions_interval_zero", "/output/reactions/interval", "0", "/output/reactions/interval",
+     "must be > 0"},
+    {"reactions_without_interval", "/output/reactions/interval", nullptr,
+     "/output/reactions/interval", "is required"},
+    {"reactions_key_typo", "/output/reactions/intervals", "1", "/output/reactions/intervals",
+     "did you mean 'interval'?"},
+    {"reactions_not_object", "/output/reactions", "0.1", "/output/reactions", "object"},
     {"name_not_string", "/name", "3", "/name", "expected a string"},
     {"gravity_length", "/gravity", "[-9.81]", "/gravity", "expected 2"},
     {"shape_function_unknown", "/shape_function", "\"quadratic\"", "/shape_function", "'bspline'"},
@@ -215,6 +222,8 @@ const Mutation mutations[] = {
      "10001 snapshots; the limit is 1000"},
     {"limit_series_rows", "/output/series/interval", "1e-9", "/output/series/interval",
      "the limit is 1000000"},
+    {"limit_reaction_rows", "/output/reactions/interval", "1e-9", "/output/reactions/interval",
+     "the limit (that of the series) is 1000000"},
 };
 
 // limit_particles needs a grid fine enough: 1000 x 1000 cells, 10 x 10 each.
@@ -227,7 +236,8 @@ json mutated(const Mutation& m) {
     spec[ptr] = json::parse(m.value);
   }
   if (std::string(m.name) == "limit_particles") spec["grid"]["cells"] = {1000, 1000};
-  if (std::string(m.name) == "limit_series_rows") spec["time"]["end"] = 20.0;
+  if (std::string(m.name) == "limit_series_rows" || std::string(m.name) == "limit_reaction_rows")
+    spec["time"]["end"] = 20.0;
   return spec;
 }
 

@@ -104,6 +104,7 @@ TEST(ParseJob, RoundTripOfEveryField) {
                                                         Field::effective_stress}));
   EXPECT_DOUBLE_EQ(p.output.series_interval, 0.001);
   EXPECT_DOUBLE_EQ(p.output.snapshot_interval, 0.005);
+  EXPECT_DOUBLE_EQ(p.output.reactions_interval, 0.002);
   // position is added: it is the VTU Points.
   EXPECT_EQ(p.output.snapshot_fields, (std::vector<Field>{Field::position, Field::velocity}));
 
@@ -193,6 +194,7 @@ TEST(ParseJob, DefaultsOfTheContract) {
   EXPECT_FALSE(p.local_damping);
   EXPECT_TRUE(p.output.series_particles.empty());
   EXPECT_DOUBLE_EQ(p.output.snapshot_interval, 0.0);
+  EXPECT_DOUBLE_EQ(p.output.reactions_interval, 0.0);  // no reactions unless asked
   EXPECT_EQ(job.cost.particles, 20);
   EXPECT_EQ(job.cost.snapshots, 0);
   EXPECT_EQ(job.cost.series_rows, 0);

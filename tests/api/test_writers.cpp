@@ -1,11 +1,15 @@
 // test_writers.cpp — the result files from synthetic data with known values:
 // series.json layout of the contract, series.csv header and rows, VTU and PVD
 // read back by an independent reader (meshio, via check_results.py), atomic
-// writes, and run_job's summary on success and on failure.
+// writes, run_job's summary on success and on failure, reactions.json and
+// reactions.csv.
 #include <atomic>
 #include <cmath>
 #include <filesystem>
+#include <sstream>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -117,6 +121,35 @@ TEST(Writers, NonFiniteValuesStayReadable) {
   const json j = json::parse(testing::read_text(dir.path() / "series.json"));  // null, still JSON
   EXPECT_TRUE(j["particles"][0]["pore_pressure"][0].is_null());
   EXPECT_NE(testing::read_text(dir.path() / "series.csv").find(",nan,"), std::string::npos);
+}
+
+// Reactions of 3 boundaries in 2D at 2 times: value = 100 * row + 10 * boundary + component.
+Reactions synthetic_reactions() {
+  Reactions r;
+  r.dimension = 2;
+  r.time = {0.25, 0.5};
+  r.force.resize(3);
+  for (std::size_t row = 0; row < r.time.size(); ++row)
+    for (std::size_t b = 0; b < r.force.size(); ++b)
+      for (int c = 0; c < 2; ++c) r.force[b].push_back(100.0 * row + 10.0 * b + c);
+  return r;
+}
+
+TEST(Writers, ReactionsJsonHasTheContractLayoutAndCsvTheSameNumbers) {
+  testing::TempDir dir;
+  const Reactions r = synthetic_reactions();
+  write_reactions_json(dir.path() / "reactions.json", r);
+  write_reactions_csv(dir.path() / "reactions.csv", r);
+  const json j = json::parse(testing::read_text(dir.path() / "reactions.json"));
+  EXPECT_EQ(j["time"], json({0.25, 0.5}));
+  ASSERT_EQ(j["boundaries"].size(), 3u);
+  EXPECT_EQ(j["boundaries"][2]["index"], 2);
+  EXPECT_EQ(j["boundaries"][2]["force"], json::parse("[[20, 21], [120, 121]]"));
+  const std::string csv = testing::read_text(dir.path() / "reactions.csv");
+  EXPECT_EQ(csv,
+            "time,b0_force_x,b0_force_y,b1_force_x,b1_force_y,b2_force_x,b2_force_y\n"
+            "0.25,0,1,10,11,20,21\n"
+            "0.5,100,101,110,111,120,121\n");
 }
 
 TEST(Writers, SnapshotsReadBackWithMeshio) {
@@ -232,16 +265,88 @@ TEST(RunJob, FailedWriteLeavesOnlyASummaryAndSaysWhy) {
   EXPECT_NE(summary["message"].get<std::string>().find("removed"), std::string::npos);
 }
 
+/// The numbers of a CSV file: its header's names and its rows.
+std::pair<std::vector<std::string>, std::vector<std::vector<double>>> read_csv(
+    const std::string& text) {
+  std::istringstream in(text);
+  std::string line;
+  std::vector<std::string> header;
+  std::vector<std::vector<double>> rows;
+  std::getline(in, line);
+  std::istringstream h(line);
+  for (std::string cell; std::getline(h, cell, ',');) header.push_back(cell);
+  while (std::getline(in, line)) {
+    std::istringstream l(line);
+    rows.emplace_back();
+    for (std::string cell; std::getline(l, cell, ',');) rows.back().push_back(std::stod(cell));
+  }
+  return {header, rows};
+}
+
+// A 2D column at rest (geostatic, dry: rho = 2000 kg/m^3, H = 1 m, W = 0.4
+// m) on a fixed base between rollers: reactions.json and reactions.csv are
+// listed, parse back, hold the same numbers, and the base carries the
+// column's weight rho g H W = 7848 N/m (to round-off, test_reactions.cpp
+// says why; 1e-9 here for the 17 significant digits of the text).
+TEST(RunJob, WritesReactionsThatParseBackAndAgree) {
+  const std::string spec = R"({
+    "name": "column", "dimension": 2,
+    "grid": {"min": [0, 0], "max": [0.4, 1.2], "cells": [4, 12]},
+    "materials": {"soil": {"model": "linear_elastic", "density": 2000, "youngs_modulus": 1e7,
+                           "poisson_ratio": 0.3}},
+    "bodies": [{"material": "soil", "box": {"min": [0, 0], "max": [0.4, 1.0]}}],
+    "gravity": [0, -9.81],
+    "initial_state": {"geostatic": {"k0": 0.5}},
+    "boundaries": [
+      {"nodes": {"box": {"min": [0, 0], "max": [0.4, 0]}}, "velocity": [0, 0]},
+      {"nodes": {"box": {"min": [0, 0], "max": [0, 1.2]}}, "velocity": [0, null]},
+      {"nodes": {"box": {"min": [0.4, 0], "max": [0.4, 1.2]}}, "velocity": [0, null]}],
+    "time": {"end": 0.05},
+    "output": {"reactions": {"interval": 0.01}}})";
+  const ParseResult parsed = parse_job(spec);
+  ASSERT_TRUE(parsed.job) << (parsed.errors.empty() ? "" : parsed.errors[0].message);
+  testing::TempDir dir;
+  const JobOutcome out = run_job(*parsed.job, dir.path());
+  ASSERT_EQ(out.run.status, RunStatus::successful) << out.run.message;
+  for (const char* f : {"reactions.json", "reactions.csv"}) {
+    EXPECT_NE(std::find(out.files.begin(), out.files.end(), f), out.files.end()) << f;
+  }
+  EXPECT_EQ(media_type_for("reactions.json"), "application/json");
+  EXPECT_EQ(media_type_for("reactions.csv"), "text/csv");
+  const json j = json::parse(testing::read_text(dir.path() / "reactions.json"));
+  const auto [header, rows] = read_csv(testing::read_text(dir.path() / "reactions.csv"));
+  ASSERT_EQ(j["boundaries"].size(), 3u);
+  ASSERT_EQ(header.size(), 1u + 3 * 2);
+  EXPECT_EQ(header[4], "b1_force_y");
+  ASSERT_EQ(rows.size(), j["time"].size());
+  ASSERT_GE(rows.size(), 5u);
+  for (std::size_t k = 0; k < rows.size(); ++k) {
+    ASSERT_EQ(rows[k].size(), header.size());
+    EXPECT_EQ(rows[k][0], j["time"][k].get<double>());
+    for (std::size_t b = 0; b < 3; ++b) {
+      EXPECT_EQ(j["boundaries"][b]["index"], b);
+      for (std::size_t c = 0; c < 2; ++c)
+        EXPECT_EQ(rows[k][1 + 2 * b + c], j["boundaries"][b]["force"][k][c].get<double>());
+    }
+    const double weight = 2000 * 9.81 * 1.0 * 0.4;
+    EXPECT_NEAR(rows[k][2], weight, 1e-9 * weight);  // the base, vertical
+    EXPECT_EQ(rows[k][4], 0.0);                      // the rollers, vertical
+    EXPECT_EQ(rows[k][6], 0.0);
+  }
+}
+
 // A run stopped after a checkpoint and resumed from it in the same folder
 // writes the files of an uninterrupted run: the snapshots before the
 // checkpoint stay (and are listed in the .pvd again), the series comes from
 // the checkpoint; summary.json differs in its wall-time fields only.
 TEST(RunJob, ResumedFromACheckpointWritesTheFilesOfAnUninterruptedRun) {
-  const ParseResult parsed =
+  ParseResult parsed =
       parse_job(testing::read_text(testing::source_path("examples/bar-vibration.json")));
   ASSERT_TRUE(parsed.job);
+  parsed.job->problem.output.reactions_interval = 0.05;  // a history in the checkpoint too
   testing::TempDir dir;
   const JobOutcome whole = run_job(*parsed.job, dir.path() / "whole");
+  EXPECT_NE(std::find(whole.files.begin(), whole.files.end(), "reactions.csv"), whole.files.end());
   ASSERT_EQ(whole.run.status, RunStatus::successful) << whole.run.message;
   const std::int64_t k = whole.run.steps / 2;
   std::string bytes;

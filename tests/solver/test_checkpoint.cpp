@@ -1,8 +1,8 @@
 // Checkpoints (RunOptions::on_checkpoint / resume, solver/src/checkpoint.hpp):
 // for each time scheme, a run resumed in a fresh run from the checkpoint of
 // step k ends with the outputs of the uninterrupted run bit for bit (every
-// snapshot array, the series, the step count and the scheme's counters), at
-// two solver threads; checkpoints of another problem, another key, truncated
+// snapshot array, the series, the reactions, the step count and the
+// scheme's counters), at two solver threads; checkpoints of another problem, another key, truncated
 // or corrupt ones are refused with a message saying why.
 #include <gtest/gtest.h>
 
@@ -76,6 +76,8 @@ hmpm::Problem block(hmpm::Scheme scheme) {
     p.output.series_interval = 20.0;
     p.output.snapshot_interval = 50.0;
   }
+  // The boundaries' reactions are a history like the series.
+  p.output.reactions_interval = p.output.series_interval;
   return p;
 }
 
@@ -167,6 +169,9 @@ TEST_P(Resume, FromAMidRunCheckpointGivesTheUninterruptedResultsBitForBit) {
   EXPECT_EQ(a.time, b.time);
   EXPECT_EQ(a.values, b.values);
   EXPECT_EQ(a.particles, b.particles);
+  ASSERT_FALSE(whole.result.reactions.time.empty());
+  EXPECT_EQ(resumed.result.reactions.time, whole.result.reactions.time);
+  EXPECT_EQ(resumed.result.reactions.force, whole.result.reactions.force);
   const auto &ia = resumed.result.iterations, &ib = whole.result.iterations;
   EXPECT_EQ(ia.nonlinear, ib.nonlinear);
   EXPECT_EQ(ia.linear, ib.linear);
@@ -211,6 +216,7 @@ TEST(Checkpoint, ACancelledRunCheckpointsWhereItStopped) {
   ASSERT_EQ(resumed.result.status, hmpm::RunStatus::successful) << resumed.result.message;
   EXPECT_EQ(resumed.result.steps, whole.result.steps);
   EXPECT_EQ(resumed.result.series.values, whole.result.series.values);
+  EXPECT_EQ(resumed.result.reactions.force, whole.result.reactions.force);
   ASSERT_EQ(resumed.snapshots.size() + 3, whole.snapshots.size());
   expect_same_snapshot(resumed.snapshots.back(), whole.snapshots.back());
 }

@@ -301,6 +301,11 @@ void check_limits(ParseContext& c) {
     c.r.error("/output/series/interval",
               "the series would have " + std::to_string(cost.series_rows) + " rows; the limit is " +
                   std::to_string(limits.max_series_rows) + "; use a larger interval");
+  if (cost.reaction_rows > limits.max_series_rows)
+    c.r.error("/output/reactions/interval",
+              "the reactions would have " + std::to_string(cost.reaction_rows) +
+                  " rows; the limit (that of the series) is " +
+                  std::to_string(limits.max_series_rows) + "; use a larger interval");
   if (cost.snapshots > limits.max_snapshots)
     c.r.error("/output/snapshots/interval",
               "the run would write " + std::to_string(cost.snapshots) +

@@ -1,5 +1,6 @@
-// output.cpp — the "output" section: the time series of chosen particles and
-// the snapshots, with their fields (names from hmpm::field_table).
+// output.cpp — the "output" section: the time series of chosen particles,
+// the snapshots, with their fields (names from hmpm::field_table), and the
+// boundaries' reaction forces.
 #include <algorithm>
 #include <limits>
 
@@ -8,12 +9,14 @@
 namespace hmpm::api::parse {
 namespace {
 
-constexpr std::string_view output_allowed[] = {"series", "snapshots"};
+constexpr std::string_view output_allowed[] = {"series", "snapshots", "reactions"};
 constexpr std::string_view series_allowed[] = {"particles", "fields", "interval"};
 constexpr std::string_view series_required[] = {"particles", "fields"};
 constexpr std::string_view near_allowed[] = {"near", "polygon"};
 constexpr std::string_view snapshots_allowed[] = {"interval", "fields"};
 constexpr std::string_view snapshots_required[] = {"interval"};
+constexpr std::string_view reactions_allowed[] = {"interval"};
+constexpr std::string_view reactions_required[] = {"interval"};
 
 std::vector<Field> read_fields(SpecReader& r, const json& j, const std::string& path) {
   std::vector<Field> out;
@@ -91,6 +94,7 @@ void output_keys(std::vector<SpecObjectKeys>& out) {
   out.push_back(keys_entry("/output/series", series_allowed));
   out.push_back(keys_entry("/output/series/particles/*", near_allowed));
   out.push_back(keys_entry("/output/snapshots", snapshots_allowed));
+  out.push_back(keys_entry("/output/reactions", reactions_allowed));
 }
 
 void read_output(ParseContext& c, const json& j, const std::string& path) {
@@ -120,6 +124,12 @@ void read_output(ParseContext& c, const json& j, const std::string& path) {
           out.snapshot_fields.insert(out.snapshot_fields.begin(), Field::position);
       }
     }
+  }
+  if (j.contains("reactions")) {
+    const json& s = j["reactions"];
+    const std::string sp = path + "/reactions";
+    if (r.object(s, sp, reactions_allowed, reactions_required))
+      r.number_at(s, sp, "interval", Range::positive(), out.reactions_interval);
   }
 }
 

@@ -330,6 +330,10 @@ struct OutputRequest {
   double series_interval = 0.0;        ///< s; <= 0: every step
   std::vector<Field> snapshot_fields;  ///< empty: all fields
   double snapshot_interval = 0.0;      ///< s; <= 0: no snapshots
+  /// s; > 0: the force each boundary exerts on the soil, sampled at the end
+  /// of the steps that reach each multiple of it (RunResult::reactions);
+  /// <= 0: none.
+  double reactions_interval = 0.0;
 };
 
 struct Problem {

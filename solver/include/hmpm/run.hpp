@@ -161,6 +161,22 @@ struct Series {
   std::vector<std::vector<double>> values;
 };
 
+/// The force each boundary of the Problem exerts on the soil (the mixture:
+/// skeleton and pore water together), sampled at OutputRequest::
+/// reactions_interval: the sum, over the node components the boundary
+/// constrains, of the nodal force that enforces its constraint. Units: N in
+/// 3D, N per metre of thickness in 2D (plane strain), N per square metre of
+/// cross-section in 1D. A node component constrained by several boundaries
+/// is charged to the one whose constraint is applied last in the order of
+/// precedence (boundary/apply.hpp: a prescribed velocity over friction over
+/// a rigid tie; among equals, the later boundary in the Problem).
+/// `force[b]` holds `dimension` values per sample time, time after time.
+struct Reactions {
+  int dimension = 1;
+  std::vector<double> time;
+  std::vector<std::vector<double>> force;  ///< per boundary: dimension values per time
+};
+
 /// The complete state of a run after `step`, as opaque bytes (the solver's
 /// versioned binary format, checkpoint.hpp): RunOptions::resume with these
 /// bytes continues the run to results bit-identical to an uninterrupted run
@@ -259,6 +275,7 @@ struct RunResult {
     std::vector<double> worst_residuals;
   } iterations;
   Series series;
+  Reactions reactions;  ///< empty unless OutputRequest::reactions_interval > 0
 };
 
 /// Runs `problem` to its end time. See the file comment for failure modes.

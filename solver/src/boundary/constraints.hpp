@@ -34,6 +34,7 @@ struct VelocityConstraint {
   /// Per node: tangential velocity cancelled by friction this step.
   /// Empty when the boundary has no friction.
   std::vector<std::uint8_t> stuck;
+  std::size_t boundary = 0;  ///< index in Problem::boundaries (for its reaction)
 
   bool has_friction() const { return !stuck.empty(); }
 };
@@ -43,6 +44,7 @@ struct RigidTie {
   std::vector<std::int64_t> nodes;
   std::array<bool, 3> axes{false, false, false};
   std::array<double, 3> remapped{0.0, 0.0, 0.0};  ///< scratch: tied re-mapped velocity
+  std::size_t boundary = 0;                       ///< index in Problem::boundaries
 };
 
 /// Pore pressure prescribed at a set of nodes: fn(t), or, when `field` is
@@ -101,13 +103,15 @@ template <int Dim>
 Constraints compile_constraints(const Problem& problem, const GridState<Dim>& grid,
                                 const VecD<Dim>& grid_max, bool fluid) {
   Constraints c;
-  for (const Boundary& b : problem.boundaries) {
+  for (std::size_t bi = 0; bi < problem.boundaries.size(); ++bi) {
+    const Boundary& b = problem.boundaries[bi];
     std::vector<std::int64_t> nodes;
     for (std::int64_t i = 0; i < grid.count; ++i)
       if (node_selected(problem, b.nodes, detail::node_position3(grid, i))) nodes.push_back(i);
     if (b.has_velocity) {
       VelocityConstraint vc;
       vc.nodes = nodes;
+      vc.boundary = bi;
       for (int a = 0; a < Dim; ++a)
         if (b.velocity[a]) {
           vc.fixed[a] = true;
@@ -125,7 +129,8 @@ Constraints compile_constraints(const Problem& problem, const GridState<Dim>& gr
       }
       c.velocity.push_back(std::move(vc));
     }
-    if (b.rigid[0] || b.rigid[1] || b.rigid[2]) c.rigid_ties.push_back({nodes, b.rigid});
+    if (b.rigid[0] || b.rigid[1] || b.rigid[2])
+      c.rigid_ties.push_back({nodes, b.rigid, {0.0, 0.0, 0.0}, bi});
     if (b.seepage && fluid) c.seepage.push_back({nodes});
     if (b.pore_pressure && fluid) {
       PressureConstraint pc{std::move(nodes), &*b.pore_pressure, nullptr, {}};

@@ -14,6 +14,7 @@
 #include "phases/grid_to_particle.hpp"
 #include "phases/particle_to_grid.hpp"
 #include "phases/pore_pressure.hpp"
+#include "phases/reactions.hpp"
 #include "phases/stress_and_flux.hpp"
 #include "schemes/time_scheme.hpp"
 #include "simulation.hpp"
@@ -44,6 +45,7 @@ class ExplicitScheme final : public TimeScheme {
     }
     sim_.apply_surface_loads(t);
     sim_.update_nodal_momentum(t, dt);
+    if (sim_.reactions_due_) sim_.tally_reactions(/*with_extra=*/false);
     update_particle_velocities_and_remap(dt);
     sim_.compute_remapped_nodal_velocity(t + dt, dt);
     update_particle_stress_and_fluid_flux(dt);

@@ -50,6 +50,7 @@
 #include "phases/particle_to_grid.hpp"
 #include "phases/pore_pressure.hpp"
 #include "phases/pressure_projection.hpp"
+#include "phases/reactions.hpp"
 #include "phases/stress_and_flux.hpp"
 #include "schemes/time_scheme.hpp"
 #include "simulation.hpp"
@@ -99,6 +100,9 @@ class SemiImplicitScheme final : public TimeScheme {
       if (!solve_pressure_increment(t, dt)) return;
       correct_nodal_momentum(t, dt);
     }
+    // Reactions with the corrector's pressure-increment force (kept by
+    // correct_nodal_momentum) among the nodal forces.
+    if (sim_.reactions_due_) sim_.tally_reactions(/*with_extra=*/sim_.fluid_);
     update_particle_velocities_and_remap(dt);
     sim_.compute_remapped_nodal_velocity(t + dt, dt);
     update_particle_stress(dt);
@@ -255,6 +259,7 @@ class SemiImplicitScheme final : public TimeScheme {
     sim_.for_particles(nodal::bit(nodal::remap), [&](const Out& out, std::size_t b, std::size_t e) {
       sim_.map_pressure_increment_force(out, b, e);
     });
+    if (sim_.reactions_due_) sim_.record_reaction_extra_force(grid.remap);
     const double tol = sim_.mass_tolerance_;
     sim_.for_nodes([&](std::int64_t b, std::int64_t e) {
       for (std::int64_t i = b; i < e; ++i) {

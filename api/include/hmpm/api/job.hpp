@@ -92,6 +92,7 @@ struct CostEstimate {
   int threads = 1;                ///< solver threads the estimate assumes
   std::int64_t output_bytes = 0;  ///< result files estimate
   std::int64_t series_rows = 0;
+  std::int64_t reaction_rows = 0;  ///< samples of output.reactions (0: none asked for)
   std::int64_t snapshots = 0;
   hmpm::Scheme scheme = hmpm::Scheme::explicit_scheme;  ///< time.scheme
   double wall_seconds = 0.0;  ///< expected wall time of the run with its scheme
