@@ -149,7 +149,9 @@ class DiskFull(unittest.TestCase):
         # Once the first snapshot (1.5 MB) is complete, no file may grow past
         # 1 MB: the second snapshot fails; the database, the logs and small
         # results stay well below that.
-        wait_for(lambda: (data / job / "snapshot_0000.vtu").is_file(), 30, "first snapshot")
+        # The job's folder: its log and the folder of its one attempt (claim 1).
+        attempt = data / job / "attempt-1"
+        wait_for(lambda: (attempt / "snapshot_0000.vtu").is_file(), 30, "first snapshot")
         set_file_size_limit(server.proc.pid, 1 << 20)
         self.addCleanup(lambda: server.proc.poll() is None and lift_file_size_limit(server.proc.pid))
         doc = wait_status(server.url, job, ("successful", "failed", "dismissed"), 60)
@@ -157,9 +159,10 @@ class DiskFull(unittest.TestCase):
         self.assertIn("could not write results", doc["message"])
         names = verify_results(server.url, job)
         self.assertEqual(names, ["summary.json"])
-        on_disk = sorted(p.name for p in (data / job).iterdir())
-        self.assertEqual(on_disk, ["job.log", "summary.json"], "files the manifest does not list")
-        summary = json.loads((data / job / "summary.json").read_text())
+        self.assertEqual(sorted(p.name for p in (data / job).iterdir()), ["attempt-1", "job.log"])
+        on_disk = sorted(p.name for p in attempt.iterdir())
+        self.assertEqual(on_disk, ["summary.json"], "files the manifest does not list")
+        summary = json.loads((attempt / "summary.json").read_text())
         self.assertEqual(summary["status"], "failed")
         self.assertEqual(summary["files"], ["summary.json"])
         # The next job, still under the limit, runs: nothing of the failed
@@ -169,7 +172,7 @@ class DiskFull(unittest.TestCase):
                          "successful")
         self.assertIn("summary.json", verify_results(server.url, after))
         record(item=8, faults=1, bad_inputs=0, requests=4, lost=0,
-               fault="result file past RLIMIT_FSIZE (EFBIG)", left_files=len(on_disk) - 1)
+               fault="result file past RLIMIT_FSIZE (EFBIG)", left_files=len(on_disk))
 
     def test_database_write_failure_is_visible_and_recovered(self):
         db = self.tmp / "db.sqlite"
