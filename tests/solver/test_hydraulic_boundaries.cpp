@@ -170,6 +170,20 @@ TEST(HydraulicBoundaries, TransientInflowMatchesTheSeriesSolutionAndConverges) {
   }
 }
 
+// The column under gravity with p_b at its base and a seepage face at its
+// top (a steady end: c t / H^2 = 8, as the inflow column), run.
+hmpm::RunResult seepage_column(const Column& col, double pb) {
+  const double end = 8.0 * col.L * col.L / col.c();
+  hmpm::Problem p = fixed_column(col, end);
+  p.boundaries.push_back(problems::fixed_pressure(problems::plane(p, 0, 0.0), pb));
+  hmpm::Boundary face;
+  face.nodes = problems::plane(p, 0, col.L);
+  face.seepage = true;
+  p.boundaries.push_back(face);
+  p.output.series_interval = end;
+  return hmpm::run(p);
+}
+
 // An artesian column (§11): base pressure p_b above the hydrostatic gamma_w
 // H, a seepage face at the top. Water leaves through the face: p = 0 there,
 // p linear, p = p_b (1 - x / H), and the outflow w = k (p_b / (gamma_w H) -
@@ -181,15 +195,7 @@ TEST(HydraulicBoundaries, SeepageFaceOfAnArtesianColumnDrainsToZeroWithTheExactO
     col.dim = dim;
     col.gravity = 9.81;
     const double pb = 1.5 * gamma_w * col.L;
-    const double end = 8.0 * col.L * col.L / col.c();
-    hmpm::Problem p = fixed_column(col, end);
-    p.boundaries.push_back(problems::fixed_pressure(problems::plane(p, 0, 0.0), pb));
-    hmpm::Boundary face;
-    face.nodes = problems::plane(p, 0, col.L);
-    face.seepage = true;
-    p.boundaries.push_back(face);
-    p.output.series_interval = end;
-    const hmpm::RunResult r = hmpm::run(p);
+    const hmpm::RunResult r = seepage_column(col, pb);
     ASSERT_EQ(r.status, hmpm::RunStatus::successful) << r.message;
     const hmpm::Series& s = r.series;
     const std::size_t last = s.time.size() - 1, np = s.particles.size();
@@ -213,14 +219,7 @@ TEST(HydraulicBoundaries, SeepageFaceBelowHydrostaticTakesNoWaterIn) {
   col.gravity = 9.81;
   const double pb = 0.6 * gamma_w * col.L;
   const double end = 8.0 * col.L * col.L / col.c();
-  hmpm::Problem p = fixed_column(col, end);
-  p.boundaries.push_back(problems::fixed_pressure(problems::plane(p, 0, 0.0), pb));
-  hmpm::Boundary face;
-  face.nodes = problems::plane(p, 0, col.L);
-  face.seepage = true;
-  p.boundaries.push_back(face);
-  p.output.series_interval = end;
-  const hmpm::RunResult r = hmpm::run(p);
+  const hmpm::RunResult r = seepage_column(col, pb);
   ASSERT_EQ(r.status, hmpm::RunStatus::successful) << r.message;
   const hmpm::Series& s = r.series;
   const std::size_t last = s.time.size() - 1, np = s.particles.size();
