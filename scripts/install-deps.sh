@@ -20,6 +20,7 @@ packages=(
   clang-format clang-tidy              # scripts/check_format.sh, scripts/check_tidy.sh (run by test.sh)
   python3                              # clients and result checks
   python3-meshio python3-matplotlib python3-jsonschema python3-numpy
+  python3-vtk9                         # tests/api/test_writers.cpp: snapshots read back by VTK itself
   python3-owslib                       # tests/python/test_ogc.py: OGC API – Processes client
   chromium chromium-driver python3-selenium  # tests/browser: the dashboard in headless Chromium
 )

@@ -39,10 +39,12 @@ JobOutcome run_job(const ParsedJob& job, const fs::path& out_dir, const hmpm::Ru
     }
   }
   RunOptions opts = options;
+  std::vector<std::string> material_names;
+  for (const Material& m : job.problem.materials) material_names.push_back(m.name);
   opts.on_snapshot = [&](const Snapshot& s) {
     const std::string name = snapshot_file_name(s.index);
     try {
-      write_snapshot_vtu(out_dir / name, s);
+      write_snapshot_vtu(out_dir / name, s, material_names);
       snapshots.emplace_back(s.time, name);
       write_pvd(out_dir / "snapshots.pvd", snapshots);
     } catch (const std::exception& e) {

@@ -336,14 +336,47 @@ class Base64Writer {
   std::string buffer_;
 };
 
+// Text for an XML attribute value.
+std::string xml_escaped(const std::string& text) {
+  std::string out;
+  for (const char ch : text) {
+    switch (ch) {
+      case '&':
+        out += "&amp;";
+        break;
+      case '<':
+        out += "&lt;";
+        break;
+      case '>':
+        out += "&gt;";
+        break;
+      case '"':
+        out += "&quot;";
+        break;
+      default:
+        out += ch;
+    }
+  }
+  return out;
+}
+
 // One inline binary DataArray: UInt64 byte count then the values, encoded
 // together (uncompressed layout of the VTK XML format).
+// Vectors' and tensors' component names (VTK's ComponentName attributes,
+// shown by ParaView in its component menus), by number of components.
+const char* const vector_components[] = {"x", "y", "z"};
+const char* const tensor_components[] = {"xx", "yy", "zz", "xy", "yz", "zx"};
+
 template <typename T, typename Source>
 void data_array(std::ostream& out, const char* type, const std::string& name, int components,
                 std::size_t count, Source value) {
   out << "        <DataArray type=\"" << type << "\"";
   if (!name.empty()) out << " Name=\"" << name << "\"";
   if (components > 1) out << " NumberOfComponents=\"" << components << "\"";
+  if (components == 3 || components == 6)
+    for (int c = 0; c < components; ++c)
+      out << " ComponentName" << c << "=\""
+          << (components == 3 ? vector_components : tensor_components)[c] << "\"";
   out << " format=\"binary\">\n";
   Base64Writer b64(out);
   const std::uint64_t bytes =
@@ -377,6 +410,8 @@ const std::vector<double>* snapshot_array(const Snapshot& s, Field f) {
       return &s.strain;
     case Field::porosity:
       return &s.porosity;
+    case Field::plastic_strain:
+      return &s.plastic_strain;
   }
   return nullptr;
 }
@@ -389,7 +424,8 @@ std::string snapshot_file_name(int index) {
   return buf;
 }
 
-void write_snapshot_vtu(const fs::path& path, const Snapshot& s) {
+void write_snapshot_vtu(const fs::path& path, const Snapshot& s,
+                        const std::vector<std::string>& material_names) {
   static_assert(sizeof(double) == 8, "Float64 arrays");
   const auto n = static_cast<std::size_t>(std::max<std::int64_t>(s.particles, 0));
   AtomicFile file(path);
@@ -403,7 +439,14 @@ void write_snapshot_vtu(const fs::path& path, const Snapshot& s) {
          "format=\"ascii\">";
   std::string t;
   append_number(t, s.time);
-  out << t << "</DataArray>\n    </FieldData>\n";
+  out << t << "</DataArray>\n";
+  // Each material's name as the name of a one-value Int32 array holding
+  // its index ("material clay" = 0): readable in ParaView's information
+  // panel and by meshio, which reads no string arrays.
+  for (std::size_t m = 0; m < material_names.size(); ++m)
+    out << "      <DataArray type=\"Int32\" Name=\"material " << xml_escaped(material_names[m])
+        << "\" NumberOfTuples=\"1\" format=\"ascii\">" << m << "</DataArray>\n";
+  out << "    </FieldData>\n";
   out << "    <Piece NumberOfPoints=\"" << n << "\" NumberOfCells=\"" << n
       << "\">\n      <PointData>\n";
   for (Field f : s.fields) {

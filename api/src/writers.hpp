@@ -59,7 +59,11 @@ void write_reactions_csv(const std::filesystem::path& path, const Reactions& rea
 /// One snapshot as a VTK UnstructuredGrid (.vtu): one vertex cell per
 /// particle, Points = positions, PointData = the snapshot's fields plus
 /// volume and material; base64-encoded little-endian binary, uncompressed.
-void write_snapshot_vtu(const std::filesystem::path& path, const Snapshot& snapshot);
+/// Vectors and tensors carry their component names (x, y, z; xx, yy, zz,
+/// xy, yz, zx); each of `material_names` (index order) becomes a one-value
+/// Int32 array of the field data named "material <name>" holding its index.
+void write_snapshot_vtu(const std::filesystem::path& path, const Snapshot& snapshot,
+                        const std::vector<std::string>& material_names = {});
 
 /// ParaView collection listing (time, file name) pairs.
 void write_pvd(const std::filesystem::path& path,

@@ -55,6 +55,9 @@ void Simulation<Dim, Shape>::fill_snapshot(Snapshot& snap, const std::vector<Fie
       case Field::porosity:
         scalar(snap.porosity, particles_.porosity);
         break;
+      case Field::plastic_strain:
+        scalar(snap.plastic_strain, particles_.plastic_strain);
+        break;
       case Field::effective_stress:
         voigt(snap.effective_stress, particles_.stress);
         break;
@@ -101,6 +104,9 @@ void Simulation<Dim, Shape>::sample_series(Series& series, double t) const {
           break;
         case Field::porosity:
           out.push_back(particles_.porosity.empty() ? 0.0 : particles_.porosity[p]);
+          break;
+        case Field::plastic_strain:
+          out.push_back(particles_.plastic_strain.empty() ? 0.0 : particles_.plastic_strain[p]);
           break;
         case Field::effective_stress:
           for (int c = 0; c < 6; ++c) out.push_back(particles_.stress[p][c]);

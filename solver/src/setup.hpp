@@ -77,7 +77,7 @@ void Simulation<Dim, Shape>::setup_particles() {
   const std::vector<BodyLayout> layouts = body_layouts(problem_);
   std::int64_t count = 0;
   for (const BodyLayout& l : layouts) count += l.count;
-  particles_.resize(static_cast<std::size_t>(count), fluid_, gimp, state_variables_);
+  particles_.resize(static_cast<std::size_t>(count), fluid_, gimp, state_variables_, plastic_);
   grid_.resize(fluid_);
   std::size_t p = 0;
   double cell_volume = 1.0;

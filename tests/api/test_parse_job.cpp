@@ -490,6 +490,18 @@ TEST(ParseJob, FluxesAndSeepageFaces) {
   ASSERT_TRUE(rb.pore_pressure_field);
   EXPECT_DOUBLE_EQ(rb.pore_pressure_field(Vec3{0.3, 0.25, 0}, 0.25), 9810 * 0.5);
   EXPECT_DOUBLE_EQ(rb.pore_pressure_field(Vec3{0.3, 0.9, 0}, 0.25), 0.0);
+  // tractions in x, y, z, t: a load growing along x; in t alone: no field.
+  ASSERT_FALSE(reservoir.problem.tractions.empty());
+  EXPECT_FALSE(reservoir.problem.tractions[0].traction_field[1]);
+  spec["tractions"][0]["traction"] = json::array({0, "-1000 * (1 + x) * min(t, 1)"});
+  const ParsedJob varying = parse_valid(spec.dump());
+  const Traction& vt = varying.problem.tractions[0];
+  EXPECT_FALSE(vt.traction_field[0]);
+  ASSERT_TRUE(vt.traction_field[1]);
+  EXPECT_DOUBLE_EQ(vt.traction_field[1](Vec3{0.5, 0.9, 0}, 0.5), -1000 * 1.5 * 0.5);
+  ASSERT_TRUE(vt.traction[1]);
+  EXPECT_DOUBLE_EQ(vt.traction[1](2.0), -1000.0) << "the value at the origin";
+  spec["tractions"][0]["traction"] = json::array({0, "-1000*min(t, 1)"});
 
   spec["fluxes"] = json::parse(R"J([
     {"particles": "all", "face": "z+", "rate": 1e-5},

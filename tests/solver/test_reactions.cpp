@@ -119,6 +119,16 @@ Errors vertical_errors(const hmpm::RunResult& r, int dim, double expected) {
   return e;
 }
 
+/// A load on the top face (y+) of the top row of particles over x in [0, b].
+hmpm::Traction top_strip(double b) {
+  hmpm::Traction t;
+  t.particles.min = {0.0, H - h / 2, 0.0};
+  t.particles.max = {b, H, 0.0};
+  t.axis = 1;
+  t.side = +1;
+  return t;
+}
+
 hmpm::RunResult run_ok(const hmpm::Problem& p, const std::string& what) {
   hmpm::RunResult r = hmpm::run(p);
   EXPECT_EQ(r.status, hmpm::RunStatus::successful) << what << ": " << r.message;
@@ -209,11 +219,7 @@ TEST(Reactions, AStripLoadAddsItsResultantToTheBaseReaction) {
   c.geostatic = false;
   hmpm::Problem p = column(c, 10.0, 1.0);
   const double q = 2e4, b = 0.2;
-  hmpm::Traction t;
-  t.particles.min = {0.0, H - h / 2, 0.0};  // the top row of particles under the strip
-  t.particles.max = {b, H, 0.0};
-  t.axis = 1;
-  t.side = +1;
+  hmpm::Traction t = top_strip(b);
   t.traction[1] = problems::constant(-q);
   p.tractions.push_back(t);
   hmpm::Boundary plate;
@@ -236,6 +242,30 @@ TEST(Reactions, AStripLoadAddsItsResultantToTheBaseReaction) {
   }
 }
 
+// A load that varies along the face (Traction::traction_field, a formula
+// in x): q(x) = q0 (1 + 2 x / b) on [0, b]. Particles sit at the centres of
+// equal sub-cells, so the midpoint rule integrates the linear q exactly:
+// the base carries W + q0 b (1 + 1) = W + 2 q0 b to Newton's tolerance. A
+// load evaluated once, at the origin, would give W + q0 b: the test tells
+// the two apart by a third of the total.
+TEST(Reactions, ALoadVaryingAlongTheFaceAddsItsIntegral) {
+  Case c;
+  c.scheme = hmpm::Scheme::quasi_static;
+  c.geostatic = false;
+  hmpm::Problem p = column(c, 10.0, 1.0);
+  const double q0 = 1e4, b = 0.2;
+  hmpm::Traction t = top_strip(b);
+  t.traction_field[1] = [=](const hmpm::Vec3& x, double) { return -q0 * (1 + 2 * x[0] / b); };
+  t.traction[1] = [=](double time) { return t.traction_field[1](hmpm::Vec3{0, 0, 0}, time); };
+  p.tractions.push_back(t);
+  const hmpm::RunResult r = run_ok(p, "varying load");
+  const double total = weight(c) + 2 * q0 * b;
+  const Errors e = vertical_errors(r, 2, total);
+  std::printf("varying load: base %.3e of W + integral q = %.6g N/m\n", e.base, total);
+  EXPECT_LT(e.base, 1e-9);
+  EXPECT_EQ(e.rollers, 0.0);
+}
+
 // The same strip load on the explicit scheme, damped to rest from the
 // geostatic state of the weight alone: the reaction settles on W + Q, Q the
 // load as the explicit scheme applies it: q times the loaded particles'
@@ -250,11 +280,7 @@ TEST(Reactions, ExplicitDampedToRestUnderAStripLoad) {
   const double end = 2.0;
   hmpm::Problem p = column(c, end, 0.2);
   const double q = 2e4, b = 0.2;
-  hmpm::Traction t;
-  t.particles.min = {0.0, H - h / 2, 0.0};
-  t.particles.max = {b, H, 0.0};
-  t.axis = 1;
-  t.side = +1;
+  hmpm::Traction t = top_strip(b);
   t.traction[1] = problems::constant(-q);
   p.tractions.push_back(t);
   p.local_damping = problems::constant(0.7);

@@ -38,10 +38,16 @@ void read_traction(ParseContext& c, const json& j, const std::string& path) {
   if (j.contains("traction")) {
     const json& v = j["traction"];
     const std::string vp = path + "/traction";
-    if (r.per_axis(v, vp, c.dim, "number or formula in t")) {
-      for (std::size_t a = 0; a < v.size() && a < 3; ++a)
-        if (auto f = read_value_of_time(c, v[a], child_pointer(vp, a)))
-          t.traction[a] = std::move(*f);
+    if (r.per_axis(v, vp, c.dim, "number or formula in x, y, z, t")) {
+      // A number or a formula in x, y, z, t (the particle's initial
+      // position): one in t alone is a value of time, evaluated once per step.
+      for (std::size_t a = 0; a < v.size() && a < 3; ++a) {
+        bool varies = false;
+        if (auto f = read_value_of_space_time(c, v[a], child_pointer(vp, a), varies)) {
+          t.traction[a] = [f = *f](double time) { return f(Vec3{0.0, 0.0, 0.0}, time); };
+          if (varies) t.traction_field[a] = std::move(*f);
+        }
+      }
     }
   }
   c.traction_paths.push_back(path + "/particles");

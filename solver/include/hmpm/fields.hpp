@@ -26,6 +26,7 @@ enum class Field : std::uint8_t {
   strain,
   porosity,
   total_stress,
+  plastic_strain,
 };
 
 /// scalar: 1 component; vector: one per axis (dim); tensor: 6 in Voigt
@@ -39,7 +40,7 @@ struct FieldInfo {
 };
 
 /// Every field, in the order of the Field enumerators.
-inline constexpr std::array<FieldInfo, 9> field_table{{
+inline constexpr std::array<FieldInfo, 10> field_table{{
     {Field::position, "position", FieldKind::vector},
     {Field::displacement, "displacement", FieldKind::vector},
     {Field::velocity, "velocity", FieldKind::vector},
@@ -49,6 +50,9 @@ inline constexpr std::array<FieldInfo, 9> field_table{{
     {Field::strain, "strain", FieldKind::tensor},
     {Field::porosity, "porosity", FieldKind::scalar},
     {Field::total_stress, "total_stress", FieldKind::tensor},
+    // Accumulated equivalent plastic strain, sum of sqrt(2/3 deps_p : deps_p)
+    // over the steps (zero for elastic materials).
+    {Field::plastic_strain, "plastic_strain", FieldKind::scalar},
 }};
 inline constexpr int field_count = static_cast<int>(field_table.size());
 

@@ -203,6 +203,12 @@ struct Traction {
   int axis = 0;                         ///< face normal axis: 0 = x, 1 = y, 2 = z
   int side = +1;                        ///< +1 for "x+", -1 for "x-"
   std::array<FieldOfTime, 3> traction;  ///< Pa, per axis
+  /// When set for an axis, the load varies along the face: each selected
+  /// particle takes traction_field[a](its initial position, t) (a load that
+  /// grows along x, a water load on a sloping face); `traction[a]` must
+  /// then be set too (the value at the origin: the checks of formulas use
+  /// it).
+  std::array<FieldOfSpaceTime, 3> traction_field;
 };
 
 /// Water flowing across one face of the particles inside `particles`

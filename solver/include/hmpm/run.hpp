@@ -144,6 +144,7 @@ struct Snapshot {
   std::vector<double> total_stress;      ///< 6
   std::vector<double> strain;            ///< 6
   std::vector<double> porosity;          ///< 1
+  std::vector<double> plastic_strain;    ///< 1, accumulated equivalent plastic strain
   std::vector<double> volume;            ///< 1, always filled
   std::vector<double> mass;              ///< 1, always filled
   std::vector<int> material;             ///< 1, always filled

@@ -34,6 +34,9 @@ struct FaceParticles {
 
 struct TractionLoad : FaceParticles {
   const Traction* source = nullptr;
+  /// The selected particles' initial positions when a component varies
+  /// along the face (Traction::traction_field); empty otherwise.
+  std::vector<Vec3> x0;
 };
 
 /// Water across a face (Flux): the selected particles and, when the rate
@@ -78,6 +81,9 @@ std::vector<TractionLoad> compile_tractions(const Problem& problem,
     TractionLoad load;
     static_cast<FaceParticles&>(load) = select_face_particles(problem, t, x0, particles, grid);
     load.source = &t;
+    if (std::any_of(t.traction_field.begin(), t.traction_field.end(),
+                    [](const FieldOfSpaceTime& f) { return static_cast<bool>(f); }))
+      for (std::int64_t p : load.particles) load.x0.push_back(x0[static_cast<std::size_t>(p)]);
     tractions.push_back(std::move(load));
   }
   return tractions;
@@ -133,10 +139,17 @@ inline void apply_tractions(const std::vector<TractionLoad>& tractions,
     Vec traction;
     for (int a = 0; a < Dim; ++a)
       traction[a] = load.source->traction[a] ? load.source->traction[a](t) : 0.0;
-    for (std::size_t k = 0; k < load.particles.size(); ++k)
+    for (std::size_t k = 0; k < load.particles.size(); ++k) {
+      // A load that varies along the face: its formula at the particle's
+      // initial position (once per loaded particle per step).
+      if (!load.x0.empty())
+        for (int a = 0; a < Dim; ++a)
+          if (load.source->traction_field[a])
+            traction[a] = load.source->traction_field[a](load.x0[k], t);
       for_face_nodes<Dim, Shape, DeadLoad>(
           load, k, particles, grid, s,
           [&](std::int64_t node, double wa) { grid.force[node] += wa * traction; });
+    }
   }
 }
 

@@ -124,19 +124,27 @@ inline MaterialConstants material_constants(const Material& m, double gravity_co
 /// and saturated alike): the closed-form return mapping of the material's
 /// model; linear-elastic materials in a run with plastic ones pass through.
 /// `state` is the particle's internal state variables (materials/ models
-/// that declare none ignore it).
-inline void return_to_yield_surface(constitutive::Voigt& sig, const MaterialConstants& mc,
-                                    [[maybe_unused]] InternalState state) {
+/// that declare none ignore it). Returns ||d eps_p|| (the Frobenius norm of
+/// the plastic strain increment, tensor components), 0 when elastic.
+inline double return_to_yield_surface(constitutive::Voigt& sig, const MaterialConstants& mc,
+                                      [[maybe_unused]] InternalState state) {
   switch (mc.model) {
     case Model::mohr_coulomb:
-      constitutive::return_mohr_coulomb(sig, mc.elastic, mc.mohr_coulomb);
-      break;
+      return constitutive::return_mohr_coulomb(sig, mc.elastic, mc.mohr_coulomb);
     case Model::drucker_prager:
-      constitutive::return_drucker_prager(sig, mc.elastic, mc.drucker_prager);
-      break;
+      return constitutive::return_drucker_prager(sig, mc.elastic, mc.drucker_prager);
     case Model::linear_elastic:
       break;
   }
+  return 0.0;
+}
+
+/// The increment of the accumulated equivalent plastic strain,
+/// sqrt(2/3 deps_p : deps_p), from ||d eps_p|| (the returns' report): the
+/// usual measure, equal to the axial plastic strain of an isochoric
+/// uniaxial plastic flow.
+inline double equivalent_plastic_strain(double plastic_norm) {
+  return 0.816496580927726 * plastic_norm;  // sqrt(2/3)
 }
 
 /// The material's elastic tangent d sigma / d eps (Voigt xx yy zz xy yz zx,

@@ -69,7 +69,10 @@ inline void Simulation<Dim, Shape>::update_particle_stress_and_fluid_flux(const 
     constexpr int changed_end = Dim == 1 ? 3 : (Dim == 2 ? 4 : 6);
     for (int c = 0; c < 3; ++c) sig[c] += lambda_tr + two_g * de[c];
     for (int c = 3; c < changed_end; ++c) sig[c] += two_g * de[c];
-    if constexpr (Plastic) return_to_yield_surface(sig, mc, {particles_.internal.data(), p});
+    if constexpr (Plastic) {
+      const double plastic = return_to_yield_surface(sig, mc, {particles_.internal.data(), p});
+      if (plastic > 0.0) particles_.plastic_strain[p] += equivalent_plastic_strain(plastic);
+    }
     for (int c = 0; c < changed_end; ++c) particles_.strain[p][c] += de[c];
     // F = I + dt grad v, a plain matrix (its determinant inlines), filled
     // element by element: Eigen's assignment loop may be left out of line in

@@ -398,7 +398,7 @@ class QuasiStaticScheme final : public TimeScheme {
   /// value then says whether the point was plastic (d_alg is only written
   /// when it was; elastic points take the elastic stiffness).
   bool particle_stress(std::size_t p, const StencilT& s, Mat& g, Voigt& de, Voigt& sig,
-                       constitutive::Tangent* d_alg = nullptr) const {
+                       constitutive::Tangent* d_alg = nullptr, double* plastic = nullptr) const {
     g.setZero();
     for (int k = 0; k < N; ++k) {
       const auto i = static_cast<std::size_t>(s.node[k]);
@@ -422,7 +422,8 @@ class QuasiStaticScheme final : public TimeScheme {
     if (!sim_.plastic_) return false;
     if (d_alg && mc.model != Model::linear_elastic)
       return return_with_tangent(sig, mc, {sim_.particles_.internal.data(), p}, *d_alg) > 0.0;
-    return_to_yield_surface(sig, mc, {sim_.particles_.internal.data(), p});
+    const double norm = return_to_yield_surface(sig, mc, {sim_.particles_.internal.data(), p});
+    if (plastic) *plastic = norm;
     return false;
   }
 
@@ -690,8 +691,10 @@ class QuasiStaticScheme final : public TimeScheme {
       sim_.template stencil_in_step<true, true>(p, s);
       Mat g;
       Voigt de, sig;
-      particle_stress(p, s, g, de, sig);
+      double plastic = 0.0;
+      particle_stress(p, s, g, de, sig, nullptr, &plastic);
       parts.stress[p] = sig;
+      if (plastic > 0.0) parts.plastic_strain[p] += equivalent_plastic_strain(plastic);
       parts.strain[p] += de;
       Mat f = Mat::Identity() + g;
       const double j = f.determinant();

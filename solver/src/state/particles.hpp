@@ -45,6 +45,11 @@ struct ParticleState {
   std::vector<double> porosity;      ///< n
   std::vector<Vec> darcy;            ///< Darcy velocity w, m/s
 
+  /// Accumulated equivalent plastic strain, sum over steps of
+  /// sqrt(2/3 deps_p : deps_p) (materials/elastic.hpp,
+  /// plastic_strain_increment); empty when no material is plastic.
+  std::vector<double> plastic_strain;
+
   /// Internal state variables of the soil models: internal[k][p] is
   /// variable k of particle p (its meaning is the particle's model's).
   /// As many arrays as the most any model with particles declares.
@@ -71,11 +76,13 @@ struct ParticleState {
     f(pressure_out);
     f(porosity);
     f(darcy);
+    f(plastic_strain);
     for (std::vector<double>& k : internal) f(k);
   }
 
-  void resize(std::size_t n, bool fluid, bool gimp, int state_variables = 0) {
+  void resize(std::size_t n, bool fluid, bool gimp, int state_variables = 0, bool plastic = false) {
     internal.assign(static_cast<std::size_t>(state_variables), std::vector<double>(n, 0.0));
+    if (plastic) plastic_strain.assign(n, 0.0);
     x.resize(n);
     x0.resize(n);
     v.assign(n, Vec::Zero());
@@ -101,6 +108,7 @@ struct ParticleState {
     if (!half_length.empty()) per += sizeof(double);
     if (!pressure.empty()) per += sizeof(double) * 3 + sizeof(Vec);
     per += sizeof(double) * internal.size();
+    if (!plastic_strain.empty()) per += sizeof(double);
     return static_cast<std::int64_t>(n * per);
   }
 };
