@@ -218,6 +218,24 @@ struct MemoryModel {
   static constexpr double setup_per_particle = 48;
 };
 
+/// Samples of the profiles (output.profiles): t = 0 and each interval.
+double profile_rows(const Problem& p) {
+  const OutputRequest& o = p.output;
+  if (o.profiles.empty() || !(o.profile_interval > 0)) return 0;
+  return std::floor(p.time.end / o.profile_interval + 1e-9) + 1;
+}
+
+/// Values of one profile sample: every component of every field of every point.
+double profile_values(const Problem& p) {
+  double values = 0;
+  for (const ProfileLine& line : p.output.profiles) {
+    double per_point = 0;
+    for (Field f : line.fields) per_point += field_components(f, p.dimension);
+    values += per_point * static_cast<double>(line.particles.size());
+  }
+  return values;
+}
+
 bool any_fluid(const Problem& p) {
   return std::any_of(p.materials.begin(), p.materials.end(),
                      [](const Material& m) { return m.hydraulic.has_value(); });
@@ -251,6 +269,8 @@ double memory_bytes(const Problem& p, const CostEstimate& c, double threads) {
     per_row += field_components(f, p.dimension) * static_cast<double>(o.series_particles.size());
   if (c.series_rows > 0)
     bytes += MemoryModel::growth * 8 * per_row * static_cast<double>(c.series_rows);
+  // The profiles: every value of every line at every profile time.
+  bytes += MemoryModel::growth * 8 * profile_values(p) * profile_rows(p);
   // The reactions: a time and a vector per boundary per sample.
   if (c.reaction_rows > 0)
     bytes += MemoryModel::growth * 8 *
@@ -396,6 +416,7 @@ CostEstimate estimate_cost(const Problem& p, const Calibration& calibration) {
   // base64 float64 in the VTU files is 8 * 4/3 bytes per number.
   const double bytes =
       4096 + rows * (1 + series_values) * 2 * 22 + reaction_rows * (1 + reaction_values) * 2 * 22 +
+      profile_rows(p) * profile_values(p) * 2 * 22 +
       snaps * (static_cast<double>(c.particles) * (snapshot_values * 32.0 / 3.0 + 16) + 4096);
   c.output_bytes = to_count(bytes);
   const double threads = solver_threads(static_cast<double>(c.particles), calibration.threads);

@@ -86,6 +86,12 @@ JobOutcome run_job(const ParsedJob& job, const fs::path& out_dir, const hmpm::Ru
     write_history("series", write_series_json, write_series_csv, outcome.run.series);
   if (out.reactions_interval > 0)
     write_history("reactions", write_reactions_json, write_reactions_csv, outcome.run.reactions);
+  if (!out.profiles.empty())
+    write_history(
+        "profiles",
+        [&](const fs::path& p, const auto& h) { write_profiles_json(p, h, job.profiles); },
+        [&](const fs::path& p, const auto& h) { write_profiles_csv(p, h, job.profiles); },
+        outcome.run.profiles);
   if (!write_error.empty()) {
     // Partial results are removed: they hold the space a full disk needs,
     // and a set of snapshots without the rest is no result.

@@ -1,6 +1,7 @@
 // writers.cpp — see writers.hpp.
 #include "writers.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -79,6 +80,25 @@ double series_value(const Series& s, std::size_t f, std::size_t r, std::size_t p
   const std::size_t np = s.particles.size();
   const std::size_t i = (r * np + p) * static_cast<std::size_t>(nc) + static_cast<std::size_t>(c);
   return i < s.values[f].size() ? s.values[f][i] : std::nan("");
+}
+
+// Appends field f of series particle p at row r as JSON: a number for a
+// scalar, an array of components for vectors and tensors (also with one
+// component, 1D); then, past 64 KiB, flushes `line` to `out`.
+void append_series_value(std::string& line, std::ostream& out, const Series& s, std::size_t f,
+                         std::size_t r, std::size_t p) {
+  const int nc = field_components(s.fields[f], s.dimension);
+  const bool scalar = field_info(s.fields[f]).kind == FieldKind::scalar;
+  if (!scalar) line += "[";
+  for (int c = 0; c < nc; ++c) {
+    if (c) line += ", ";
+    append_json_number(line, series_value(s, f, r, p, nc, c));
+  }
+  if (!scalar) line += "]";
+  if (line.size() > (1u << 16)) {
+    out << line;
+    line.clear();
+  }
 }
 
 std::size_t series_rows(const Series& s) {
@@ -169,24 +189,12 @@ void write_series_json(const fs::path& path, const Series& s) {
     line += "]";
     out << line;
     for (std::size_t f = 0; f < s.fields.size() && f < s.values.size(); ++f) {
-      const int nc = field_components(s.fields[f], s.dimension);
-      // Vectors and tensors are arrays of components, also with one component (1D).
-      const bool scalar = field_info(s.fields[f]).kind == FieldKind::scalar;
       line = ",\n   ";
       line += json_string(field_name(s.fields[f]));
       line += ": [";
       for (std::size_t r = 0; r < rows; ++r) {
         if (r) line += ", ";
-        if (!scalar) line += "[";
-        for (int c = 0; c < nc; ++c) {
-          if (c) line += ", ";
-          append_json_number(line, series_value(s, f, r, p, nc, c));
-        }
-        if (!scalar) line += "]";
-        if (line.size() > (1u << 16)) {
-          out << line;
-          line.clear();
-        }
+        append_series_value(line, out, s, f, r, p);
       }
       line += "]";
       out << line;
@@ -229,6 +237,140 @@ void write_series_csv(const fs::path& path, const Series& s) {
       }
     out << line << '\n';
   }
+  file.commit();
+}
+
+namespace {
+
+// The column names of a field ("pore_pressure", "effective_stress_xx", ...):
+// vectors always carry an axis suffix (also in 1D), scalars none.
+std::vector<std::string> field_columns(Field field, int dimension) {
+  std::vector<std::string> out;
+  const FieldKind kind = field_info(field).kind;
+  for (int c = 0; c < field_components(field, dimension); ++c) {
+    std::string name = field_name(field);
+    if (kind == FieldKind::tensor) name += std::string("_") + tensor_suffix[c];
+    if (kind == FieldKind::vector) name += std::string("_") + vector_suffix[c];
+    out.push_back(std::move(name));
+  }
+  return out;
+}
+
+void append_point(std::string& line, const Vec3& x, int dimension) {
+  line += "[";
+  for (int a = 0; a < dimension; ++a) {
+    if (a) line += ", ";
+    append_json_number(line, x[static_cast<std::size_t>(a)]);
+  }
+  line += "]";
+}
+
+double distance(const Vec3& a, const Vec3& b) {
+  return std::sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) +
+                   (a[2] - b[2]) * (a[2] - b[2]));
+}
+
+}  // namespace
+
+void write_profiles_json(const fs::path& path, const std::vector<Series>& profiles,
+                         const std::vector<ProfileGeometry>& geometry) {
+  AtomicFile file(path);
+  std::ostream& out = file.stream();
+  std::string line = "{\"time\": [";
+  const std::vector<double> no_times;
+  const std::vector<double>& times = profiles.empty() ? no_times : profiles[0].time;
+  for (std::size_t r = 0; r < times.size(); ++r) {
+    if (r) line += ", ";
+    append_json_number(line, times[r]);
+  }
+  line += "],\n \"profiles\": [";
+  out << line;
+  for (std::size_t l = 0; l < profiles.size() && l < geometry.size(); ++l) {
+    const Series& s = profiles[l];
+    const ProfileGeometry& g = geometry[l];
+    line = l ? ",\n  {" : "\n  {";
+    line += "\"index\": " + std::to_string(l) + ", \"from\": ";
+    append_point(line, g.from, s.dimension);
+    line += ", \"to\": ";
+    append_point(line, g.to, s.dimension);
+    line += ",\n   \"points\": [";
+    for (std::size_t k = 0; k < g.points.size(); ++k) {
+      if (k) line += ", ";
+      append_point(line, g.points[k], s.dimension);
+    }
+    line += "],\n   \"distance\": [";
+    for (std::size_t k = 0; k < g.points.size(); ++k) {
+      if (k) line += ", ";
+      append_json_number(line, distance(g.points[k], g.from));
+    }
+    line += "],\n   \"particles\": [";
+    for (std::size_t k = 0; k < s.particles.size(); ++k)
+      line += (k ? ", " : "") + std::to_string(s.particles[k]);
+    line += "],\n   \"initial_positions\": [";
+    for (std::size_t k = 0; k < s.initial_positions.size(); ++k) {
+      if (k) line += ", ";
+      append_point(line, s.initial_positions[k], s.dimension);
+    }
+    line += "]";
+    out << line;
+    for (std::size_t f = 0; f < s.fields.size() && f < s.values.size(); ++f) {
+      line = ",\n   " + json_string(field_name(s.fields[f])) + ": [";
+      for (std::size_t r = 0; r < s.time.size(); ++r) {
+        line += r ? ",\n    [" : "\n    [";
+        for (std::size_t k = 0; k < s.particles.size(); ++k) {
+          if (k) line += ", ";
+          append_series_value(line, out, s, f, r, k);
+        }
+        line += "]";
+      }
+      line += "]";
+      out << line;
+    }
+    out << "}";
+  }
+  out << "\n ]\n}\n";
+  file.commit();
+}
+
+void write_profiles_csv(const fs::path& path, const std::vector<Series>& profiles,
+                        const std::vector<ProfileGeometry>& geometry) {
+  // One row per time, profile and point; the columns of every field any
+  // profile has (empty where a profile does not have it).
+  std::vector<Field> fields;
+  int dimension = 1;
+  for (const Series& s : profiles) {
+    dimension = s.dimension;
+    for (Field f : s.fields)
+      if (std::find(fields.begin(), fields.end(), f) == fields.end()) fields.push_back(f);
+  }
+  AtomicFile file(path);
+  std::ostream& out = file.stream();
+  std::string line = "time,profile,point,distance";
+  for (Field f : fields)
+    for (const std::string& column : field_columns(f, dimension)) line += "," + column;
+  out << line << '\n';
+  const std::size_t rows = profiles.empty() ? 0 : profiles[0].time.size();
+  for (std::size_t r = 0; r < rows; ++r)
+    for (std::size_t l = 0; l < profiles.size() && l < geometry.size(); ++l) {
+      const Series& s = profiles[l];
+      for (std::size_t k = 0; k < s.particles.size() && k < geometry[l].points.size(); ++k) {
+        line.clear();
+        append_number(line, r < s.time.size() ? s.time[r] : std::nan(""));
+        line += "," + std::to_string(l) + "," + std::to_string(k) + ",";
+        append_number(line, distance(geometry[l].points[k], geometry[l].from));
+        for (Field f : fields) {
+          const auto at = std::find(s.fields.begin(), s.fields.end(), f);
+          const int nc = field_components(f, dimension);
+          for (int c = 0; c < nc; ++c) {
+            line += ',';
+            if (at != s.fields.end())
+              append_number(line, series_value(s, static_cast<std::size_t>(at - s.fields.begin()),
+                                               r, k, nc, c));
+          }
+        }
+        out << line << '\n';
+      }
+    }
   file.commit();
 }
 
@@ -362,21 +504,17 @@ std::string xml_escaped(const std::string& text) {
 
 // One inline binary DataArray: UInt64 byte count then the values, encoded
 // together (uncompressed layout of the VTK XML format).
-// Vectors' and tensors' component names (VTK's ComponentName attributes,
-// shown by ParaView in its component menus), by number of components.
-const char* const vector_components[] = {"x", "y", "z"};
-const char* const tensor_components[] = {"xx", "yy", "zz", "xy", "yz", "zx"};
-
 template <typename T, typename Source>
 void data_array(std::ostream& out, const char* type, const std::string& name, int components,
                 std::size_t count, Source value) {
   out << "        <DataArray type=\"" << type << "\"";
   if (!name.empty()) out << " Name=\"" << name << "\"";
   if (components > 1) out << " NumberOfComponents=\"" << components << "\"";
+  // Component names (shown by ParaView in its component menus).
   if (components == 3 || components == 6)
     for (int c = 0; c < components; ++c)
-      out << " ComponentName" << c << "=\""
-          << (components == 3 ? vector_components : tensor_components)[c] << "\"";
+      out << " ComponentName" << c << "=\"" << (components == 3 ? vector_suffix : tensor_suffix)[c]
+          << "\"";
   out << " format=\"binary\">\n";
   Base64Writer b64(out);
   const std::uint64_t bytes =

@@ -56,6 +56,19 @@ void write_reactions_json(const std::filesystem::path& path, const Reactions& re
 /// reactions.csv: header "time,b<index>_force_<x|y|z>,..."; one row per time.
 void write_reactions_csv(const std::filesystem::path& path, const Reactions& reactions);
 
+/// profiles.json: {"time": [...], "profiles": [{"index", "from", "to",
+/// "points", "distance" (from `from`), "particles", "initial_positions",
+/// <field>: one row per time, one value (scalar) or array of components per
+/// point}]}: output.profiles, one entry per line.
+void write_profiles_json(const std::filesystem::path& path, const std::vector<Series>& profiles,
+                         const std::vector<ProfileGeometry>& geometry);
+
+/// profiles.csv: "time,profile,point,distance,<field columns>", one row per
+/// time, profile and point (columns as series.csv's without the particle
+/// prefix; empty where a profile lacks the field).
+void write_profiles_csv(const std::filesystem::path& path, const std::vector<Series>& profiles,
+                        const std::vector<ProfileGeometry>& geometry);
+
 /// One snapshot as a VTK UnstructuredGrid (.vtu): one vertex cell per
 /// particle, Points = positions, PointData = the snapshot's fields plus
 /// volume and material; base64-encoded little-endian binary, uncompressed.

@@ -22,6 +22,8 @@ std::uint64_t fingerprint(const Problem& problem, const std::string& key) {
   mix(problem.output.series_interval);
   mix(problem.output.snapshot_interval);
   mix(problem.output.reactions_interval);
+  mix(problem.output.profile_interval);
+  mix(problem.output.profiles.size());
   return h;
 }
 

@@ -662,6 +662,20 @@ std::vector<ProblemIssue> check_problem(const Problem& problem) {
           "particle " + std::to_string(p) + " does not exist; there are " + std::to_string(n) +
               " particles (0.." + std::to_string(n - 1) + ")");
   }
+  const OutputRequest& out = problem.output;
+  for (std::size_t l = 0; l < out.profiles.size(); ++l) {
+    const Location where = Location{"output", "profiles", "lines"} / l;
+    for (const std::int64_t p : out.profiles[l].particles)
+      if (p < 0 || p >= n) {
+        add(where, "particle " + std::to_string(p) + " does not exist; there are " +
+                       std::to_string(n) + " particles");
+        break;
+      }
+    if (out.profiles[l].particles.empty() || out.profiles[l].fields.empty())
+      add(where, "needs particles and fields");
+  }
+  if (!out.profiles.empty() && !(out.profile_interval > 0))
+    add({"output", "profiles", "interval"}, "must be > 0");
   for (ProblemIssue& issue : check_geostatic(problem)) issues.push_back(std::move(issue));
   return issues;
 }

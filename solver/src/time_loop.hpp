@@ -82,17 +82,30 @@ RunResult Simulation<Dim, Shape>::run(const RunOptions& options) {
   const OutputRequest& out = problem_.output;
   Series& series = result.series;
   series.dimension = Dim;
-  const bool want_series = !out.series_particles.empty() && !out.series_fields.empty();
-  if (want_series) {
-    series.particles = out.series_particles;
-    series.fields = out.series_fields;
-    series.values.resize(series.fields.size());
-    for (std::int64_t pi : series.particles) {
+  // A series (or a profile) of these particles and fields, empty.
+  auto start_series = [&](Series& s, const std::vector<std::int64_t>& particles,
+                          const std::vector<Field>& fields) {
+    s.dimension = Dim;
+    s.particles = particles;
+    s.fields = fields;
+    s.values.resize(fields.size());
+    for (std::int64_t pi : particles) {
       Vec3 x0{0, 0, 0};
       for (int a = 0; a < Dim; ++a) x0[a] = particles_.x[static_cast<std::size_t>(pi)][a];
-      series.initial_positions.push_back(x0);
+      s.initial_positions.push_back(x0);
     }
+  };
+  const bool want_series = !out.series_particles.empty() && !out.series_fields.empty();
+  if (want_series) start_series(series, out.series_particles, out.series_fields);
+  // Profiles: sampled together at t = 0 and every profile_interval.
+  std::vector<Series>& profiles = result.profiles;
+  const bool want_profiles = !out.profiles.empty() && out.profile_interval > 0;
+  if (want_profiles) {
+    profiles.resize(out.profiles.size());
+    for (std::size_t l = 0; l < profiles.size(); ++l)
+      start_series(profiles[l], out.profiles[l].particles, out.profiles[l].fields);
   }
+  double next_profile = out.profile_interval;
   // Reactions: one vector per boundary per sample, the first at t =
   // interval (a step's reaction needs the step).
   Reactions& reactions = result.reactions;
@@ -148,6 +161,16 @@ RunResult Simulation<Dim, Shape>::run(const RunOptions& options) {
                                   " boundaries where this run has " +
                                   std::to_string(reactions.force.size()));
     for (std::vector<double>& v : reactions.force) r.array(v, -1, "reactions");
+    next_profile = r.pod<double>();
+    const auto lines = r.pod<std::uint64_t>();
+    if (lines != profiles.size())
+      throw std::invalid_argument("the checkpoint has " + std::to_string(lines) +
+                                  " profiles where this run has " +
+                                  std::to_string(profiles.size()));
+    for (Series& s : profiles) {
+      r.array(s.time, -1, "profile times");
+      for (std::vector<double>& v : s.values) r.array(v, -1, "profile values");
+    }
     particles_.for_each_array(
         [&](auto& a) { r.array(a, static_cast<std::int64_t>(a.size()), "particle array"); });
     time_scheme.load(r);
@@ -158,6 +181,7 @@ RunResult Simulation<Dim, Shape>::run(const RunOptions& options) {
           " bytes more than this run's state");
   } else {
     if (want_series) sample_series(series, 0.0);
+    for (Series& s : profiles) sample_series(s, 0.0);
     if (want_snapshots) take_snapshot(0.0);
   }
 
@@ -196,6 +220,12 @@ RunResult Simulation<Dim, Shape>::run(const RunOptions& options) {
     w.array(reactions.time);
     w.pod(static_cast<std::uint64_t>(reactions.force.size()));
     for (const std::vector<double>& v : reactions.force) w.array(v);
+    w.pod(next_profile);
+    w.pod(static_cast<std::uint64_t>(profiles.size()));
+    for (const Series& s : profiles) {
+      w.array(s.time);
+      for (const std::vector<double>& v : s.values) w.array(v);
+    }
     particles_.for_each_array([&](const auto& a) { w.array(a); });
     time_scheme.save(w);
     checkpoint::finish(w);
@@ -273,6 +303,10 @@ RunResult Simulation<Dim, Shape>::run(const RunOptions& options) {
       for (std::size_t b = 0; b < reactions.force.size(); ++b)
         for (int a = 0; a < Dim; ++a) reactions.force[b].push_back(reaction_[b][a]);
       while (next_reaction <= t + eps_t) next_reaction += out.reactions_interval;
+    }
+    if (want_profiles && t >= next_profile - eps_t) {
+      for (Series& s : profiles) sample_series(s, t);
+      while (next_profile <= t + eps_t) next_profile += out.profile_interval;
     }
     if (want_snapshots && t >= next_snapshot - eps_t) {
       take_snapshot(t);

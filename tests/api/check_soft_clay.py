@@ -13,7 +13,9 @@ z = H - x, M = pi (2m + 1)/2, T_v = c_v t / H^2, c_v = k/(gamma_w (m_v + Q))):
           = -m_v q (x - H sum 2/M^2 cos(M z/H) exp(-M^2 T_v))
 and u(H, t) = -m_v q H U(T_v), U = 1 - sum 2/M^2 exp(-M^2 T_v).
 
-Checked at every series row with 0.05 <= T_v <= 0.848 (U = 90 % at the end):
+Checked at every series row with 0.05 <= T_v <= 0.848 (U = 90 % at the end),
+and at every time of the profile (output.profiles: every particle of the
+column, so the isochrones):
 - the pore pressure of every series particle deeper than one cell below the
   drained face within 1 % of q;
 - the degree of consolidation from the settlement, U_h = -u_top/(m_v q H),
@@ -102,6 +104,50 @@ def main():
         if abs(u_h - u_e) > 0.01:
             problems.append(f"T_v = {tv:.4f}: U from the settlement {u_h:.4f}, closed form "
                             f"{u_e:.4f} at the top particle")
+    # The profile (profiles.json, read back with profiles.csv): the pore
+    # pressure of every particle of the column at each profile time, the
+    # isochrones, against the same closed form and tolerance.
+    with open(os.path.join(out, "profiles.json")) as f:
+        profiles = json.load(f)
+    profile = profiles["profiles"][0]
+    line = spec["output"]["profiles"]["lines"][0]
+    if len(profile["particles"]) != line["points"]:
+        problems.append(f"the profile has {len(profile['particles'])} points, "
+                        f"not {line['points']}")
+    for point, x0 in zip(profile["points"], profile["initial_positions"]):
+        if abs(point[0] - x0[0]) > 1e-9:  # the points are the particles' centres
+            problems.append(f"profile point {point} got the particle at {x0}")
+    worst_profile, profile_rows = 0.0, 0
+    for row, t in enumerate(profiles["time"]):
+        tv = c_v * t / height ** 2
+        if tv < 0.05 - 1e-9 or tv > 0.848 + 1e-9:
+            continue
+        profile_rows += 1
+        for x0, value in zip(profile["initial_positions"], profile["pore_pressure"][row]):
+            z = height - x0[0]
+            if z < h:
+                continue
+            err = abs(value - pressure(z, tv, height, q)) / q
+            worst_profile = max(worst_profile, err)
+            if err > 0.01:
+                problems.append(f"profile at T_v = {tv:.4f}, depth {z:.3f} m: {value:.1f} Pa, "
+                                f"Terzaghi {pressure(z, tv, height, q):.1f} Pa")
+    with open(os.path.join(out, "profiles.csv")) as f:
+        csv_rows = [r.split(",") for r in f.read().splitlines()]
+    if csv_rows[0][:5] != ["time", "profile", "point", "distance", "pore_pressure"]:
+        problems.append(f"profiles.csv header {csv_rows[0]}")
+    elif len(csv_rows) - 1 != len(profiles["time"]) * line["points"]:
+        problems.append(f"profiles.csv has {len(csv_rows) - 1} rows")
+    else:  # the last row: the last time, the last point
+        last = csv_rows[-1]
+        if (float(last[0]) != profiles["time"][-1]
+                or abs(float(last[4]) - profile["pore_pressure"][-1][-1]) >
+                1e-6 * abs(profile["pore_pressure"][-1][-1]) + 1e-9):
+            problems.append(f"profiles.csv's last row {last} differs from profiles.json")
+    print(f"soft clay profile: {profile_rows} times in T_v 0.05..0.848, {len(profile['particles'])} "
+          f"points; max |p - p_exact|/q = {worst_profile:.4f} (interior)")
+    if profile_rows < 8:
+        problems.append(f"only {profile_rows} profile times in T_v 0.05..0.848")
     tv_end = c_v * series["time"][-1] / height ** 2
     print(f"soft clay: {rows} rows over T_v 0.05..{tv_end:.3f}; max |p - p_exact|/q = "
           f"{worst_p:.4f} (interior), max |U_h - U_exact(x_top)| = {worst_u:.4f} "

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <variant>
 
 #include <gtest/gtest.h>
@@ -529,6 +530,63 @@ TEST(ParseJob, FluxesAndSeepageFaces) {
   for (const SpecError& e : dry_r.errors)
     named |= e.path == "/fluxes/0" && e.message.find("hydraulic") != std::string::npos;
   EXPECT_TRUE(named);
+}
+
+}  // namespace
+}  // namespace hmpm::api
+
+namespace hmpm::api {
+namespace {
+
+// output.profiles: the particles nearest to equally spaced points of each
+// line (by initial position), the geometry kept for the writers; each
+// mistake with its JSON pointer, and a point outside the bodies refused.
+TEST(ParseJob, ProfilesPickTheParticlesNearestToTheirPoints) {
+  json spec = json::parse(read_text(source_path("tests/api/data/valid-2d.json")));
+  spec["output"]["profiles"] = json::parse(R"J({"interval": 0.002, "lines": [
+    {"from": [0.0625, 0.0625], "to": [0.0625, 0.6875], "points": 6, "fields": ["pore_pressure"]},
+    {"from": [0.1, 0.3], "to": [0.9, 0.3], "points": 2, "fields": ["strain", "plastic_strain"]}]})J");
+  const ParsedJob job = parse_valid(spec.dump());
+  const OutputRequest& out = job.problem.output;
+  EXPECT_EQ(out.profile_interval, 0.002);
+  ASSERT_EQ(out.profiles.size(), 2u);
+  // Rows of 8 particles (4 cells x 2); the second body starts at 32.
+  EXPECT_EQ(out.profiles[0].particles, (std::vector<std::int64_t>{0, 8, 16, 24, 32, 40}));
+  EXPECT_EQ(out.profiles[0].fields, std::vector<Field>{Field::pore_pressure});
+  EXPECT_EQ(out.profiles[1].particles, (std::vector<std::int64_t>{16, 23}));
+  ASSERT_EQ(job.profiles.size(), 2u);
+  ASSERT_EQ(job.profiles[0].points.size(), 6u);
+  EXPECT_DOUBLE_EQ(job.profiles[0].points[3][1], 0.0625 + 3 * 0.125);
+  EXPECT_EQ(job.profiles[1].to[0], 0.9);
+  EXPECT_GT(job.cost.output_bytes,
+            parse_valid(read_text(source_path("tests/api/data/valid-2d.json"))).cost.output_bytes);
+
+  spec["output"]["profiles"] = json::parse(R"J({"lines": [
+    {"from": [0.5, 0.5], "to": [0.5, 1.4], "points": 4, "fields": ["pore_pressure"]},
+    {"from": [0.5, 0.5, 0], "to": [0.5, 0.6], "points": 1, "fields": ["pressure"]}]})J");
+  const ParseResult bad = parse_job(spec.dump());
+  std::map<std::string, std::string> at;
+  for (const SpecError& e : bad.errors) at[e.path] += e.message;
+  EXPECT_NE(at["/output/profiles/interval"].find("required"), std::string::npos);
+  EXPECT_FALSE(at["/output/profiles/lines/1/from"].empty()) << "three components in 2D";
+  EXPECT_FALSE(at["/output/profiles/lines/1/points"].empty()) << "one point is no line";
+  EXPECT_NE(at["/output/profiles/lines/1/fields/0"].find("pore_pressure"), std::string::npos)
+      << at["/output/profiles/lines/1/fields/0"];
+  EXPECT_FALSE(bad.job.has_value());
+
+  // A line leaving the bodies (checked with the whole problem, once every
+  // section is valid).
+  spec["output"]["profiles"] = json::parse(R"J({"interval": 0.002, "lines": [
+    {"from": [0.5, 0.5], "to": [0.5, 1.4], "points": 4, "fields": ["pore_pressure"]}]})J");
+  spec["grid"]["max"] = json::array({1, 1.5});
+  spec["grid"]["cells"] = json::array({4, 6});
+  const ParseResult outside = parse_job(spec.dump());
+  ASSERT_FALSE(outside.errors.empty());
+  EXPECT_EQ(outside.errors[0].path, "/output/profiles/lines/0");
+  EXPECT_NE(outside.errors[0].message.find("point 2 at (0.5, 1.1) is more than a cell from every "
+                                           "particle"),
+            std::string::npos)
+      << outside.errors[0].message;
 }
 
 }  // namespace

@@ -153,6 +153,47 @@ TEST(Writers, ReactionsJsonHasTheContractLayoutAndCsvTheSameNumbers) {
             "0.5,100,101,110,111,120,121\n");
 }
 
+// profiles.json and profiles.csv: two lines with different fields, two
+// times; the CSV's columns are the union, empty where a line lacks one.
+TEST(Writers, ProfilesHaveTheirPointsDistancesAndRows) {
+  testing::TempDir dir;
+  std::vector<Series> profiles(2);
+  std::vector<ProfileGeometry> geometry(2);
+  for (std::size_t l = 0; l < 2; ++l) {
+    Series& s = profiles[l];
+    s.dimension = 2;
+    s.time = {0.0, 0.5};
+    s.particles = {static_cast<std::int64_t>(10 * l), static_cast<std::int64_t>(10 * l + 1)};
+    s.initial_positions = {{0.0, 0.0, 0}, {0.0, 1.0, 0}};
+    geometry[l].from = {0.0, 0.0, 0};
+    geometry[l].to = {0.0, 2.0, 0};
+    geometry[l].points = {{0.0, 0.0, 0}, {0.0, 2.0, 0}};
+  }
+  profiles[0].fields = {Field::pore_pressure};
+  profiles[0].values = {{1, 2, 3, 4}};  // rows: time, then point
+  profiles[1].fields = {Field::displacement};
+  profiles[1].values = {{1, 2, 3, 4, 5, 6, 7, 8}};
+  write_profiles_json(dir.path() / "profiles.json", profiles, geometry);
+  write_profiles_csv(dir.path() / "profiles.csv", profiles, geometry);
+  const json j = json::parse(testing::read_text(dir.path() / "profiles.json"));
+  EXPECT_EQ(j["time"], json({0.0, 0.5}));
+  ASSERT_EQ(j["profiles"].size(), 2u);
+  EXPECT_EQ(j["profiles"][0]["distance"], json({0.0, 2.0}));
+  EXPECT_EQ(j["profiles"][0]["pore_pressure"], json::parse("[[1, 2], [3, 4]]"));
+  EXPECT_EQ(j["profiles"][1]["displacement"], json::parse("[[[1, 2], [3, 4]], [[5, 6], [7, 8]]]"));
+  EXPECT_EQ(j["profiles"][1]["particles"], json({10, 11}));
+  EXPECT_EQ(testing::read_text(dir.path() / "profiles.csv"),
+            "time,profile,point,distance,pore_pressure,displacement_x,displacement_y\n"
+            "0,0,0,0,1,,\n"
+            "0,0,1,2,2,,\n"
+            "0,1,0,0,,1,2\n"
+            "0,1,1,2,,3,4\n"
+            "0.5,0,0,0,3,,\n"
+            "0.5,0,1,2,4,,\n"
+            "0.5,1,0,0,,5,6\n"
+            "0.5,1,1,2,,7,8\n");
+}
+
 TEST(Writers, SnapshotsReadBackWithMeshio) {
   testing::TempDir dir;
   std::vector<std::pair<double, std::string>> entries;

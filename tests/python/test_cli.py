@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import subprocess
 import tempfile
 import unittest
 import uuid
@@ -11,7 +12,7 @@ from pathlib import Path
 
 from hmpm_client import Client
 
-from .support import (CLIENT_DIR, JOB_TIMEOUT_S, REPO, LiveServerCase, ServerProcess, bar_spec, column_spec,
+from .support import (CLIENT_DIR, JOB_TIMEOUT_S, REPO, LiveServerCase, ServerProcess, bar_spec, build_dir, column_spec,
                       invalid_spec, long_spec, run_cli, wait_until)
 
 
@@ -154,6 +155,28 @@ class CliTest(LiveServerCase):
         r = run_cli(["plot", str(self.tmp), "--out", str(self.tmp / "none.png")], timeout=60)
         self.assertEqual(r.returncode, 1)
         self.assertIn("no series.json", r.stderr)
+
+    @unittest.skipUnless(have_matplotlib(), "matplotlib is not installed (Debian: python3-matplotlib)")
+    def test_plot_a_profile_of_a_local_result_folder(self):
+        # The soft-clay example's isochrones (output.profiles), run by the
+        # built `hmpm` (half a second), plotted with no service.
+        out = self.tmp / "soft-clay"
+        run = subprocess.run([str(build_dir() / "bin" / "hmpm"), "run",
+                              str(REPO / "examples" / "soft-clay.json"), "--out", str(out)],
+                             capture_output=True, text=True, timeout=120)
+        self.assertEqual(run.returncode, 0, run.stderr)
+        png = self.tmp / "isochrones.png"
+        r = run_cli(["--url", "http://127.0.0.1:9", "plot", str(out), "--profile", "0",
+                     "--field", "pore_pressure", "--out", str(png)], timeout=60)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        self.assertEqual(png.read_bytes()[:8], b"\x89PNG\r\n\x1a\n")
+        r = run_cli(["plot", str(out), "--profile", "3", "--out", str(self.tmp / "x.png")], timeout=60)
+        self.assertEqual(r.returncode, 1)
+        self.assertIn("there is no line 3", r.stderr)
+        r = run_cli(["plot", str(out), "--profile", "0", "--field", "strain",
+                     "--out", str(self.tmp / "x.png")], timeout=60)
+        self.assertEqual(r.returncode, 1)
+        self.assertIn("it has: pore_pressure", r.stderr)
 
     def test_status_takes_the_8_characters_the_progress_bar_prints(self):
         job_id = self.submit_and_wait(bar_spec())

@@ -76,8 +76,11 @@ hmpm::Problem block(hmpm::Scheme scheme) {
     p.output.series_interval = 20.0;
     p.output.snapshot_interval = 50.0;
   }
-  // The boundaries' reactions are a history like the series.
+  // The boundaries' reactions and the profiles are histories like the series.
   p.output.reactions_interval = p.output.series_interval;
+  p.output.profiles = {{{1, 2, 3}, {hmpm::Field::pore_pressure}},
+                       {{4, 5}, {hmpm::Field::displacement, hmpm::Field::strain}}};
+  p.output.profile_interval = 1.5 * p.output.series_interval;
   return p;
 }
 
@@ -118,6 +121,7 @@ void expect_same_snapshot(const hmpm::Snapshot& a, const hmpm::Snapshot& b) {
   EXPECT_EQ(a.total_stress, b.total_stress);
   EXPECT_EQ(a.strain, b.strain);
   EXPECT_EQ(a.porosity, b.porosity);
+  EXPECT_EQ(a.plastic_strain, b.plastic_strain);
   EXPECT_EQ(a.volume, b.volume);
   EXPECT_EQ(a.mass, b.mass);
   EXPECT_EQ(a.material, b.material);
@@ -172,6 +176,13 @@ TEST_P(Resume, FromAMidRunCheckpointGivesTheUninterruptedResultsBitForBit) {
   ASSERT_FALSE(whole.result.reactions.time.empty());
   EXPECT_EQ(resumed.result.reactions.time, whole.result.reactions.time);
   EXPECT_EQ(resumed.result.reactions.force, whole.result.reactions.force);
+  ASSERT_EQ(whole.result.profiles.size(), 2u);
+  ASSERT_GE(whole.result.profiles[1].time.size(), 3u);
+  ASSERT_EQ(resumed.result.profiles.size(), 2u);
+  for (std::size_t l = 0; l < 2; ++l) {
+    EXPECT_EQ(resumed.result.profiles[l].time, whole.result.profiles[l].time);
+    EXPECT_EQ(resumed.result.profiles[l].values, whole.result.profiles[l].values);
+  }
   const auto &ia = resumed.result.iterations, &ib = whole.result.iterations;
   EXPECT_EQ(ia.nonlinear, ib.nonlinear);
   EXPECT_EQ(ia.linear, ib.linear);

@@ -5,8 +5,10 @@
 // limits of a shared server from the cost estimate.
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "cost_model.hpp"
+#include "hmpm/format.hpp"
 #include "parser.hpp"
 
 namespace hmpm::api::parse {
@@ -141,6 +143,55 @@ void resolve_near(ParseContext& c) {
       c.r.error(s.path, "no particle exists");
     else
       c.p.output.series_particles[s.slot] = i;
+  }
+}
+
+/// The particle nearest to each point of each output.profiles line (by
+/// initial position). A point farther than a cell diagonal from every
+/// particle lies outside the bodies: an error naming it, so that a profile
+/// never reports a particle from somewhere else.
+void resolve_profiles(ParseContext& c) {
+  if (c.profiles.empty()) return;
+  std::size_t points = 0;
+  for (const ProfileGeometry& g : c.profiles) points += g.points.size();
+  const std::vector<Vec3> x0 = initial_positions(c.p);
+  if (static_cast<double>(points) * static_cast<double>(x0.size()) > max_near_work) {
+    c.r.error("/output/profiles/lines", std::to_string(points) + " profile points over " +
+                                            std::to_string(x0.size()) +
+                                            " particles is too much work; use fewer points");
+    return;
+  }
+  double diagonal2 = 0;
+  for (int a = 0; a < c.dim; ++a) {
+    const double h = (c.p.grid.max[a] - c.p.grid.min[a]) / c.p.grid.cells[a];
+    diagonal2 += h * h;
+  }
+  for (std::size_t l = 0; l < c.profiles.size(); ++l) {
+    std::vector<std::int64_t>& parts = c.p.output.profiles[l].particles;
+    parts.clear();
+    for (std::size_t k = 0; k < c.profiles[l].points.size(); ++k) {
+      const Vec3& at = c.profiles[l].points[k];
+      double best = std::numeric_limits<double>::infinity();
+      std::int64_t nearest = -1;
+      for (std::size_t p = 0; p < x0.size(); ++p) {
+        double d2 = 0;
+        for (int a = 0; a < c.dim; ++a) d2 += (x0[p][a] - at[a]) * (x0[p][a] - at[a]);
+        if (d2 < best) {
+          best = d2;
+          nearest = static_cast<std::int64_t>(p);
+        }
+      }
+      if (nearest < 0 || best > diagonal2) {
+        std::string where;
+        for (int a = 0; a < c.dim; ++a) where += (a ? ", " : "") + format_significant(at[a], 6);
+        c.r.error(child_pointer("/output/profiles/lines", l),
+                  "point " + std::to_string(k) + " at (" + where +
+                      ") is more than a cell from every particle: keep the line inside the "
+                      "bodies");
+        break;
+      }
+      parts.push_back(nearest);
+    }
   }
 }
 
@@ -322,6 +373,7 @@ void check_whole_problem(ParseContext& c) {
   if (!check_particle_budget(c)) return;
   resolve_near(c);
   resolve_series_polygons(c);
+  resolve_profiles(c);
   for (const ProblemIssue& issue : check_problem(c.p))
     c.r.error(pointer_of_solver_location(issue.where), issue.message);
   if (c.r.error_count() > 0) return;

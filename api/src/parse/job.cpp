@@ -120,6 +120,7 @@ ParseResult parse_text(std::string_view text, const Limits& limits) {
   if (result.errors.empty()) {
     ParsedJob job;
     job.name = c.name;
+    job.profiles = std::move(c.profiles);
     job.cost = estimate_cost(c.p);
     job.warnings = std::move(c.warnings);
     for (const ProblemIssue& w : problem_warnings(c.p))

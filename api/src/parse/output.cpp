@@ -9,7 +9,9 @@
 namespace hmpm::api::parse {
 namespace {
 
-constexpr std::string_view output_allowed[] = {"series", "snapshots", "reactions"};
+constexpr std::string_view output_allowed[] = {"series", "snapshots", "reactions", "profiles"};
+constexpr std::string_view profiles_allowed[] = {"interval", "lines"};
+constexpr std::string_view line_allowed[] = {"from", "to", "points", "fields"};
 constexpr std::string_view series_allowed[] = {"particles", "fields", "interval"};
 constexpr std::string_view series_required[] = {"particles", "fields"};
 constexpr std::string_view near_allowed[] = {"near", "polygon"};
@@ -77,6 +79,46 @@ void read_series_particles(ParseContext& c, const json& parts, const std::string
   }
 }
 
+// output.profiles: {"interval", "lines": [{"from", "to", "points", "fields"}]}.
+// The particles nearest to each point are found with the whole problem
+// (resolve_profiles in checks.cpp).
+void read_profiles(ParseContext& c, const json& j, const std::string& path) {
+  SpecReader& r = c.r;
+  OutputRequest& out = c.p.output;
+  if (!r.object(j, path, profiles_allowed, profiles_allowed)) return;
+  r.number_at(j, path, "interval", Range::positive(), out.profile_interval);
+  if (!j.contains("lines")) return;
+  const json& lines = j["lines"];
+  const std::string lp = path + "/lines";
+  if (!r.array(lines, lp, 1)) return;
+  for (std::size_t i = 0; i < lines.size(); ++i) {
+    const std::string ip = child_pointer(lp, i);
+    const json& e = lines[i];
+    if (!r.object(e, ip, line_allowed, line_allowed)) continue;
+    ProfileGeometry g;
+    ProfileLine line;
+    const auto from = e.contains("from") ? r.vector(e["from"], ip + "/from", c.dim) : std::nullopt;
+    const auto to = e.contains("to") ? r.vector(e["to"], ip + "/to", c.dim) : std::nullopt;
+    std::int64_t points = 0;
+    if (e.contains("points"))
+      if (auto n = r.integer(e["points"], ip + "/points", 2, c.limits.max_series_particles))
+        points = *n;
+    if (e.contains("fields")) line.fields = read_fields(r, e["fields"], ip + "/fields");
+    if (from && to && points >= 2) {
+      g.from = *from;
+      g.to = *to;
+      for (std::int64_t k = 0; k < points; ++k) {
+        const double s = static_cast<double>(k) / static_cast<double>(points - 1);
+        Vec3 x{0, 0, 0};
+        for (int a = 0; a < 3; ++a) x[a] = g.from[a] + s * (g.to[a] - g.from[a]);
+        g.points.push_back(x);
+      }
+    }
+    c.profiles.push_back(std::move(g));
+    out.profiles.push_back(std::move(line));
+  }
+}
+
 }  // namespace
 
 Keys field_names() {
@@ -95,6 +137,8 @@ void output_keys(std::vector<SpecObjectKeys>& out) {
   out.push_back(keys_entry("/output/series/particles/*", near_allowed));
   out.push_back(keys_entry("/output/snapshots", snapshots_allowed));
   out.push_back(keys_entry("/output/reactions", reactions_allowed));
+  out.push_back(keys_entry("/output/profiles", profiles_allowed));
+  out.push_back(keys_entry("/output/profiles/lines/*", line_allowed));
 }
 
 void read_output(ParseContext& c, const json& j, const std::string& path) {
@@ -125,6 +169,7 @@ void read_output(ParseContext& c, const json& j, const std::string& path) {
       }
     }
   }
+  if (j.contains("profiles")) read_profiles(c, j["profiles"], path + "/profiles");
   if (j.contains("reactions")) {
     const json& s = j["reactions"];
     const std::string sp = path + "/reactions";

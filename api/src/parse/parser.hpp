@@ -74,6 +74,7 @@ struct ParseContext {
   std::map<std::string, int> material_index;
   std::vector<PendingNear> near;
   std::vector<PendingPolygon> series_polygons;
+  std::vector<ProfileGeometry> profiles;  ///< output.profiles.lines, particles resolved later
   std::vector<PositionFormula> position_formulas;
   std::vector<TimeFormula> time_formulas;
   bool damping_formula = false;         ///< local_damping given as a formula of t

@@ -5,7 +5,7 @@
     python3 -m hmpm_client --url URL wait ID | results ID | download ID DIR | log ID
     python3 -m hmpm_client --url URL cancel ID     # stop a queued/running job, keep its files
     python3 -m hmpm_client --url URL delete ID     # dismiss a job and delete its files
-    python3 -m hmpm_client --url URL plot ID|DIR --field pore_pressure [--out FILE.png]
+    python3 -m hmpm_client --url URL plot ID|DIR --field pore_pressure [--out FILE.png] [--profile LINE]
 
 `plot` takes a job id, or a local folder holding series.json (what
 `download` or `hmpm run --out` wrote), so no service is needed for it.
@@ -92,6 +92,9 @@ def _parser() -> argparse.ArgumentParser:
     s.add_argument("id", metavar="ID|DIR", help="a job id, or a local result folder with series.json")
     s.add_argument("--field", default="pore_pressure", help="series field (default: pore_pressure)")
     s.add_argument("--out", metavar="FILE.png", help="output file (default: ID-FIELD.png)")
+    s.add_argument("--profile", metavar="LINE", type=int,
+                   help="plot line LINE of profiles.json (the field along the line, a curve per "
+                        "time) instead of the series")
     return p
 
 
@@ -212,22 +215,28 @@ def cmd_download(client: Client, args) -> int:
 
 
 def cmd_plot(client: Client, args) -> int:
-    from .plot import MatplotlibMissing, plot_series
+    from .plot import MatplotlibMissing, plot_profile, plot_series
     local = Path(args.id)
     label = local.name if local.is_dir() else args.id
-    out = Path(args.out or f"{label}-{args.field}.png")
+    profile = args.profile is not None
+    name, section = ("profiles.json", "output.profiles") if profile else ("series.json", "output.series")
+    out = Path(args.out or f"{label}-{args.field}{f'-profile{args.profile}' if profile else ''}.png")
     try:
         if local.is_dir():
-            path = local / "series.json"
+            path = local / name
             if not path.is_file():
-                _err(f"{local}: no series.json in this folder (the spec's output.series was empty?)")
+                _err(f"{local}: no {name} in this folder (did the spec ask for {section}?)")
                 return EXIT_ERROR
-            series = json.loads(path.read_text())
+            doc = json.loads(path.read_text())
             title = f"{local}: {args.field}"
         else:
-            series = client.job(args.id).series()
+            job = client.job(args.id)
+            doc = json.loads(job.read_result(name)) if profile else job.series()
             title = f"job {args.id}: {args.field}"
-        plot_series(series, args.field, out, title=title)
+        if profile:
+            plot_profile(doc, args.field, out, line=args.profile, title=title + f", profile {args.profile}")
+        else:
+            plot_series(doc, args.field, out, title=title)
     except MatplotlibMissing as e:
         _err(str(e))
         return EXIT_NO_MATPLOTLIB

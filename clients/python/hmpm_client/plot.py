@@ -16,7 +16,7 @@ from typing import Any, Dict, List, Optional, Sequence
 UNITS = {
     "position": "m", "displacement": "m", "velocity": "m/s", "darcy_velocity": "m/s",
     "pore_pressure": "Pa", "effective_stress": "Pa", "stress": "Pa", "total_stress": "Pa",
-    "strain": "-", "porosity": "-",
+    "strain": "-", "porosity": "-", "plastic_strain": "-",
 }
 VECTOR_NAMES = ("x", "y", "z")
 VOIGT_NAMES = ("xx", "yy", "zz", "xy", "yz", "zx")
@@ -102,6 +102,64 @@ def plot_series(series: Dict[str, Any], field: str, out: Path, title: Optional[s
     axes[-1][0].set_xlabel("time [s]")
     axes[0][0].legend(fontsize="small", loc="best")
     fig.suptitle(title or field)
+    fig.tight_layout()
+    out = Path(out)
+    if out.parent and not out.parent.exists():
+        out.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(out, dpi=110)
+    plt.close(fig)
+    return out
+
+
+def plot_profile(profiles: Dict[str, Any], field: str, out: Path, line: int = 0,
+                 title: Optional[str] = None) -> Path:
+    """Writes a PNG of `field` along profile `line` of profiles.json: the
+    field against the distance from the line's start, one curve per
+    profile time (isochrones). Vectors and tensors: one axes per component
+    that is not zero throughout.
+
+    Raises MatplotlibMissing without matplotlib, and ValueError when there
+    is no such line or field.
+    """
+    lines = profiles.get("profiles") or []
+    if not 0 <= line < len(lines):
+        raise ValueError(f"profiles.json has {len(lines)} line(s); there is no line {line}")
+    prof = lines[line]
+    fields = sorted(k for k, v in prof.items()
+                    if isinstance(v, list) and k not in ("from", "to", "points", "distance",
+                                                         "particles", "initial_positions"))
+    if field not in prof or field not in fields:
+        raise ValueError(f"profile {line} has no field {field!r}; it has: {', '.join(fields) or 'none'}")
+    plt = _import_pyplot()
+    times = profiles.get("time") or []
+    distance = prof.get("distance") or []
+    rows = prof[field]
+    first = rows[0][0] if rows and rows[0] else 0
+    ncomp = len(first) if isinstance(first, list) else 0
+    names = list(component_names(ncomp)) if ncomp else [""]
+    columns = list(range(len(names)))
+    if ncomp > 1:
+        nonzero = [c for c in columns if any(v[c] != 0 for row in rows for v in row)]
+        columns = nonzero or columns[:1]
+    fig, axes = plt.subplots(1, len(columns), sharey=True, squeeze=False,
+                             figsize=(3.2 + 3.0 * len(columns), 5.0))
+    unit = UNITS.get(field, "")
+    cmap = plt.get_cmap("viridis")
+    for k, col in enumerate(columns):
+        comp = names[col]
+        ax = axes[0][k]
+        for r, row in enumerate(rows):
+            xs = [v[col] if isinstance(v, list) else v for v in row]
+            t = times[r] if r < len(times) else float("nan")
+            ax.plot(xs, distance[:len(xs)], marker=".", markersize=3,
+                    color=cmap(r / max(1, len(rows) - 1)), label=f"t = {t:.4g} s")
+        ax.set_xlabel(field + (f" {comp}" if comp else "") + (f" [{unit}]" if unit else ""))
+        ax.grid(True, alpha=0.3)
+    frm = ", ".join(f"{c:.3g}" for c in prof.get("from", []))
+    to = ", ".join(f"{c:.3g}" for c in prof.get("to", []))
+    axes[0][0].set_ylabel(f"distance from ({frm}) towards ({to}) [m]")
+    axes[0][-1].legend(fontsize="x-small", loc="best")
+    fig.suptitle(title or f"{field} along profile {line}")
     fig.tight_layout()
     out = Path(out)
     if out.parent and not out.parent.exists():

@@ -330,6 +330,13 @@ inline const char* scheme_name(Scheme s) {
   return "explicit";
 }
 
+/// A profile: fields of the particles nearest to points along a line (the
+/// api picks them: output.profiles in the job spec), sampled together.
+struct ProfileLine {
+  std::vector<std::int64_t> particles;  ///< global particle indices, one per point
+  std::vector<Field> fields;
+};
+
 struct OutputRequest {
   std::vector<std::int64_t> series_particles;  ///< global particle indices
   std::vector<Field> series_fields;
@@ -340,6 +347,10 @@ struct OutputRequest {
   /// of the steps that reach each multiple of it (RunResult::reactions);
   /// <= 0: none.
   double reactions_interval = 0.0;
+  /// Profiles, each sampled (like a series) at t = 0 and at the end of the
+  /// steps that reach each multiple of profile_interval (> 0 when any).
+  std::vector<ProfileLine> profiles;
+  double profile_interval = 0.0;
 };
 
 struct Problem {

@@ -277,6 +277,9 @@ struct RunResult {
   } iterations;
   Series series;
   Reactions reactions;  ///< empty unless OutputRequest::reactions_interval > 0
+  /// One per OutputRequest::profiles line: its particles' fields at each
+  /// profile time.
+  std::vector<Series> profiles;
 };
 
 /// Runs `problem` to its end time. See the file comment for failure modes.

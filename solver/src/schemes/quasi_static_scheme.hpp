@@ -109,7 +109,8 @@ class QuasiStaticScheme final : public TimeScheme {
   double next_dt(double t) override {
     double h = nominal_;
     const OutputRequest& out = sim_.problem_.output;
-    for (double interval : {out.series_interval, out.snapshot_interval, out.reactions_interval}) {
+    for (double interval : {out.series_interval, out.snapshot_interval, out.reactions_interval,
+                            out.profile_interval}) {
       if (!(interval > 0)) continue;
       const double next = (std::floor(t / interval + 1e-9) + 1.0) * interval;
       if (t + 1.25 * h >= next - 1e-9 * interval) h = std::min(h * 1.25, next - t);

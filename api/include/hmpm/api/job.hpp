@@ -102,9 +102,19 @@ struct CostEstimate {
   std::vector<SchemeCost> schemes;
 };
 
+/// Where a profile's points lie (output.profiles.lines[i]): `points`
+/// equally spaced from `from` to `to`, ends included; problem.output.
+/// profiles[i] holds the particle nearest to each.
+struct ProfileGeometry {
+  hmpm::Vec3 from{0, 0, 0};
+  hmpm::Vec3 to{0, 0, 0};
+  std::vector<hmpm::Vec3> points;
+};
+
 struct ParsedJob {
   std::string name;
   hmpm::Problem problem;
+  std::vector<ProfileGeometry> profiles;  ///< one per problem.output.profiles line
   CostEstimate cost;
   /// Runnable, but worth knowing before running (hmpm::problem_warnings),
   /// with JSON pointers like errors; the run's summary repeats them.
