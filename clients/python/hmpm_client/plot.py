@@ -1,4 +1,5 @@
-"""Time-history plots of a job's series particles (matplotlib, Agg backend).
+"""Plots of a job's series particles (time histories) and profiles (a field
+along a line, a curve per time); matplotlib, Agg backend.
 
 matplotlib is optional: the client itself uses the standard library only, and
 `plot_series` raises `MatplotlibMissing` (with the Debian package to install)
@@ -37,6 +38,16 @@ def _import_pyplot():
             "On Debian: sudo apt-get install python3-matplotlib, then run the client with /usr/bin/python3"
         ) from None
     return plt
+
+
+def _save(plt, fig, out: Path) -> Path:
+    fig.tight_layout()
+    out = Path(out)
+    if out.parent and not out.parent.exists():
+        out.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(out, dpi=110)
+    plt.close(fig)
+    return out
 
 
 def component_names(n: int) -> Sequence[str]:
@@ -102,13 +113,7 @@ def plot_series(series: Dict[str, Any], field: str, out: Path, title: Optional[s
     axes[-1][0].set_xlabel("time [s]")
     axes[0][0].legend(fontsize="small", loc="best")
     fig.suptitle(title or field)
-    fig.tight_layout()
-    out = Path(out)
-    if out.parent and not out.parent.exists():
-        out.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(out, dpi=110)
-    plt.close(fig)
-    return out
+    return _save(plt, fig, out)
 
 
 def plot_profile(profiles: Dict[str, Any], field: str, out: Path, line: int = 0,
@@ -160,10 +165,4 @@ def plot_profile(profiles: Dict[str, Any], field: str, out: Path, line: int = 0,
     axes[0][0].set_ylabel(f"distance from ({frm}) towards ({to}) [m]")
     axes[0][-1].legend(fontsize="x-small", loc="best")
     fig.suptitle(title or f"{field} along profile {line}")
-    fig.tight_layout()
-    out = Path(out)
-    if out.parent and not out.parent.exists():
-        out.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(out, dpi=110)
-    plt.close(fig)
-    return out
+    return _save(plt, fig, out)
