@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Runs every example with two builds of the `hmpm` command and compares
-# series.json byte for byte (the rooms issue's "identical results" check).
+# series.json and reactions.json byte for byte (the rooms issue's "identical results" check).
 #   bash scripts/compare_examples.sh OLD_BIN_DIR NEW_BIN_DIR [THREADS...]
 # OLD_BIN_DIR/NEW_BIN_DIR hold an `hmpm` executable (e.g. build/bin).
 # Exit 0 when every example's series.json (and summary.json's "steps")
@@ -20,10 +20,18 @@ for spec in examples/*.json; do
     fi
     "$old/hmpm" run "$spec" --out "$work/old-$name-$t" --threads "$t" >/dev/null 2>&1 || true
     "$new/hmpm" run "$spec" --out "$work/new-$name-$t" --threads "$t" >/dev/null 2>&1 || true
-    a=$(sha256sum < "$work/old-$name-$t/series.json" | cut -c1-16)
-    b=$(sha256sum < "$work/new-$name-$t/series.json" | cut -c1-16)
-    if [ "$a" = "$b" ]; then echo "identical  $name threads=$t series.json $a"
-    else echo "DIFFERENT  $name threads=$t series.json $a vs $b"; status=1; fi
+    # Every history both builds wrote (an example may ask for reactions
+    # only, as the footing does).
+    compared=0
+    for file in series.json reactions.json; do
+      [ -f "$work/old-$name-$t/$file" ] || continue
+      compared=1
+      a=$(sha256sum < "$work/old-$name-$t/$file" | cut -c1-16)
+      b=$(sha256sum < "$work/new-$name-$t/$file" 2>/dev/null | cut -c1-16 || true)
+      if [ "$a" = "$b" ]; then echo "identical  $name threads=$t $file $a"
+      else echo "DIFFERENT  $name threads=$t $file $a vs ${b:-missing}"; status=1; fi
+    done
+    [ $compared = 1 ] || { echo "NO HISTORY $name threads=$t (neither series.json nor reactions.json)"; status=1; }
   done
 done
 exit $status
