@@ -37,7 +37,7 @@
 namespace hmpm::checkpoint {
 
 inline constexpr char magic[8] = {'H', 'M', 'P', 'M', 'C', 'K', 'P', 'T'};
-inline constexpr std::uint32_t version = 3;  ///< 2: reactions; 3: plastic strain
+inline constexpr std::uint32_t version = 3;  ///< 2: reactions; 3: plastic strain, profiles
 
 /// FNV-1a, 64 bits, continuing from `h`.
 inline std::uint64_t fnv1a(const char* data, std::size_t n,

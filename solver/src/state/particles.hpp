@@ -46,8 +46,8 @@ struct ParticleState {
   std::vector<Vec> darcy;            ///< Darcy velocity w, m/s
 
   /// Accumulated equivalent plastic strain, sum over steps of
-  /// sqrt(2/3 deps_p : deps_p) (materials/elastic.hpp,
-  /// plastic_strain_increment); empty when no material is plastic.
+  /// sqrt(2/3 deps_p : deps_p) (equivalent_plastic_strain in
+  /// materials/material.hpp); empty when no material is plastic.
   std::vector<double> plastic_strain;
 
   /// Internal state variables of the soil models: internal[k][p] is
