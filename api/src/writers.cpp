@@ -304,8 +304,10 @@ void write_profiles_json(const fs::path& path, const std::vector<Series>& profil
       append_json_number(line, distance(g.points[k], g.from));
     }
     line += "],\n   \"particles\": [";
-    for (std::size_t k = 0; k < s.particles.size(); ++k)
-      line += (k ? ", " : "") + std::to_string(s.particles[k]);
+    for (std::size_t k = 0; k < s.particles.size(); ++k) {
+      if (k) line += ", ";
+      line += std::to_string(s.particles[k]);
+    }
     line += "],\n   \"initial_positions\": [";
     for (std::size_t k = 0; k < s.initial_positions.size(); ++k) {
       if (k) line += ", ";
@@ -347,7 +349,10 @@ void write_profiles_csv(const fs::path& path, const std::vector<Series>& profile
   std::ostream& out = file.stream();
   std::string line = "time,profile,point,distance";
   for (Field f : fields)
-    for (const std::string& column : field_columns(f, dimension)) line += "," + column;
+    for (const std::string& column : field_columns(f, dimension)) {
+      line += ',';
+      line += column;
+    }
   out << line << '\n';
   const std::size_t rows = profiles.empty() ? 0 : profiles[0].time.size();
   for (std::size_t r = 0; r < rows; ++r)
@@ -356,7 +361,13 @@ void write_profiles_csv(const fs::path& path, const std::vector<Series>& profile
       for (std::size_t k = 0; k < s.particles.size() && k < geometry[l].points.size(); ++k) {
         line.clear();
         append_number(line, r < s.time.size() ? s.time[r] : std::nan(""));
-        line += "," + std::to_string(l) + "," + std::to_string(k) + ",";
+        // Piece by piece: GCC 12 warns (-Wstringop-overflow, a false
+        // positive) on "literal" + std::string&& here, fatal under -Werror.
+        line += ',';
+        line += std::to_string(l);
+        line += ',';
+        line += std::to_string(k);
+        line += ',';
         append_number(line, distance(geometry[l].points[k], geometry[l].from));
         for (Field f : fields) {
           const auto at = std::find(s.fields.begin(), s.fields.end(), f);

@@ -419,16 +419,10 @@ void check_bearing(const Problem& p, const std::vector<BodyLayout>& layouts,
   for (std::size_t k = 0; k < p.tractions.size(); ++k) {
     const Traction& t = p.tractions[k];
     if (t.axis != v || t.side != up_side || !t.traction[v]) continue;
-    // The peak pressure over the run (compression: the traction against the outward normal).
-    double peak = 0;
-    for (int i = 0; i <= 200; ++i) {
-      const double value = t.traction[v](p.time.end * i / 200.0);
-      if (std::isfinite(value)) peak = std::max(peak, -value * t.side);
-    }
-    if (!(peak > 0)) continue;
     int body = -1;
     bool one_body = true;
     double lo = std::numeric_limits<double>::infinity(), hi = -lo, low_row = lo;
+    std::vector<Vec3> loaded;  // initial positions of the loaded particles
     for (std::size_t b = 0; b < layouts.size(); ++b)
       for (const Vec3& x : layouts[b].positions) {
         if (!particle_selected(p, t, x)) continue;
@@ -437,8 +431,27 @@ void check_bearing(const Problem& p, const std::vector<BodyLayout>& layouts,
         lo = std::min(lo, x[h]);
         hi = std::max(hi, x[h]);
         low_row = std::min(low_row, up_side * x[v]);
+        loaded.push_back(x);
       }
     if (body < 0 || !one_body) continue;
+    // The peak pressure over the run (compression: the traction against the
+    // outward normal); a load that varies along the strip by its mean over
+    // the loaded particles, the average pressure the bearing capacity is
+    // compared with.
+    const FieldOfSpaceTime& varying = t.traction_field[v];
+    double peak = 0;
+    for (int i = 0; i <= 200; ++i) {
+      const double time = p.time.end * i / 200.0;
+      double value = 0;
+      if (varying) {
+        for (const Vec3& x : loaded) value += varying(x, time);
+        value /= static_cast<double>(loaded.size());
+      } else {
+        value = t.traction[v](time);
+      }
+      if (std::isfinite(value)) peak = std::max(peak, -value * t.side);
+    }
+    if (!(peak > 0)) continue;
     const Body& bd = p.bodies[static_cast<std::size_t>(body)];
     if (bd.polygon || bd.prism || bd.points) continue;  // a box layer only
     const Material& m = p.materials[static_cast<std::size_t>(bd.material)];
@@ -481,7 +494,8 @@ void check_bearing(const Problem& p, const std::vector<BodyLayout>& layouts,
     if (!(peak > q_ult)) continue;
     out.push_back(
         {Location{"tractions"} / k,
-         "presses with up to " + fmt(peak) + " Pa on a strip of width " + fmt(width) + " m" +
+         "presses with up to " + fmt(peak) + " Pa" + (varying ? " on average" : "") +
+             " on a strip of width " + fmt(width) + " m" +
              symmetry + " on top of body " + std::to_string(body) + " ('" + m.name +
              "'), above its drained strip bearing capacity q_ult = c Nc + gamma' B N_gamma / 2 = " +
              fmt(q_ult) + " Pa (Prandtl/Terzaghi surface footing, Vesic's N_gamma; c = " +

@@ -198,6 +198,27 @@ TEST(Plausibility, StripLoadAboveTheBearingCapacity) {
   EXPECT_NE(warning_at(strong, "/tractions/0"), "");
 }
 
+// A load that varies along the strip (a formula in x) is compared by its
+// mean over the loaded particles: q(x) = 2 q_m x on the half strip [0, 1]
+// (particle centres 0.125 .. 0.875, mean x 0.5, so mean q_m, peak 1.75 q_m).
+// 0.9 q_ult on average stands (a peak or a pointwise check would warn);
+// 1.1 q_ult warns (the value at the origin, 0, would not).
+TEST(Plausibility, AVaryingStripLoadIsJudgedByItsMean) {
+  const std::string uniform = warning_at(footing(5e5), "/tractions/0");
+  ASSERT_FALSE(uniform.empty());
+  const double q_ult = number_after(uniform, "a load below ");
+  auto varying = [&](double mean) {
+    json spec = footing(0);
+    std::string formula = "-2*x*";
+    formula += std::to_string(mean);
+    spec["tractions"][0]["traction"][1] = formula;
+    return warning_at(spec, "/tractions/0");
+  };
+  EXPECT_EQ(varying(0.9 * q_ult), "");
+  const std::string over = varying(1.1 * q_ult);
+  EXPECT_NE(over.find("Pa on average on a strip of width 2 m"), std::string::npos) << over;
+}
+
 // Only where the estimate applies: an elastic layer, a load at a free edge
 // (no symmetry plane), or a layer shallower than the footing is wide.
 TEST(Plausibility, BearingCapacityOnlyWhereTheStripFormulaApplies) {

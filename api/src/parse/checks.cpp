@@ -183,7 +183,10 @@ void resolve_profiles(ParseContext& c) {
       }
       if (nearest < 0 || best > diagonal2) {
         std::string where;
-        for (int a = 0; a < c.dim; ++a) where += (a ? ", " : "") + format_significant(at[a], 6);
+        for (int a = 0; a < c.dim; ++a) {
+          if (a) where += ", ";
+          where += format_significant(at[a], 6);
+        }
         c.r.error(child_pointer("/output/profiles/lines", l),
                   "point " + std::to_string(k) + " at (" + where +
                       ") is more than a cell from every particle: keep the line inside the "
