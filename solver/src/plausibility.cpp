@@ -495,8 +495,8 @@ void check_bearing(const Problem& p, const std::vector<BodyLayout>& layouts,
     out.push_back(
         {Location{"tractions"} / k,
          "presses with up to " + fmt(peak) + " Pa" + (varying ? " on average" : "") +
-             " on a strip of width " + fmt(width) + " m" +
-             symmetry + " on top of body " + std::to_string(body) + " ('" + m.name +
+             " on a strip of width " + fmt(width) + " m" + symmetry + " on top of body " +
+             std::to_string(body) + " ('" + m.name +
              "'), above its drained strip bearing capacity q_ult = c Nc + gamma' B N_gamma / 2 = " +
              fmt(q_ult) + " Pa (Prandtl/Terzaghi surface footing, Vesic's N_gamma; c = " +
              fmt(s.c) + " Pa, phi = " + fmt(s.phi) + " degrees, " +
