@@ -62,6 +62,8 @@ struct CommandResult {
 };
 
 /// Runs `command` through the shell with stdout and stderr captured.
+/// `scratch` receives cmd.stdout and cmd.stderr: a folder of the test's own
+/// (tests run in parallel; two sharing one folder read each other's output).
 inline CommandResult run_command(const std::string& command, const std::filesystem::path& scratch) {
   const auto out = scratch / "cmd.stdout", err = scratch / "cmd.stderr";
   const std::string full = command + " >'" + out.string() + "' 2>'" + err.string() + "'";

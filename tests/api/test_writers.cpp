@@ -215,14 +215,14 @@ TEST(Writers, SnapshotsReadBackWithMeshio) {
                                dir.path().string() + "' --hmpm '" + HMPM_EXE +
                                "' --particles 7 --require-snapshots --snapshot-fields "
                                "velocity,pore_pressure,effective_stress\"",
-                           fs::temp_directory_path());
+                           dir.path());
   EXPECT_EQ(r.exit_code, 0) << r.out << r.err;
   // Exact values through meshio.
   const std::string probe =
       py + " -c \"import meshio; m = meshio.read('" + (dir.path() / "snapshot_0002.vtu").string() +
       "'); print(m.points[3].tolist(), m.point_data['effective_stress'][3].tolist(), "
       "m.point_data['material'].tolist(), m.point_data['pore_pressure'][6])\"";
-  const auto v = testing::run_command(probe, fs::temp_directory_path());
+  const auto v = testing::run_command(probe, dir.path());
   EXPECT_EQ(v.out,
             "[3.0, 6.0, 0.0] [-3.0, -6.0, -9.0, -12.0, -15.0, -18.0] [0, 1, 0, 1, 0, 1, 0] 106.0\n")
       << v.err;
@@ -255,7 +255,7 @@ TEST(Writers, SnapshotsCarryComponentAndMaterialNamesForVtk) {
                            "print([e.GetValue(i) for i in range(e.GetNumberOfTuples())])\n";
   const auto v = testing::run_command(
       "/usr/bin/python3 '" + script + "' '" + (dir.path() / "snapshot_0001.vtu").string() + "'",
-      fs::temp_directory_path());
+      dir.path());
   EXPECT_EQ(v.exit_code, 0) << v.err;
   EXPECT_EQ(v.out,
             "velocity ['x', 'y', 'z']\n"
