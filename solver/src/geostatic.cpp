@@ -178,7 +178,7 @@ std::vector<ProblemIssue> check_geostatic(const Problem& problem) {
 GeostaticState geostatic_state(const Problem& problem, const SetupInterrupt* interrupt) {
   const Geostatic& geo = *problem.initial_state.geostatic;
   const Vertical v = vertical_of(problem);
-  const std::vector<BodyLayout> layouts = body_layouts(problem);
+  const std::vector<BodyLayout> layouts = body_layouts(problem, LayoutDetail::counts);
   const std::vector<BodyExtent> extents = body_extents(problem, layouts);
   const int dim = problem.dimension;
   GeostaticState out;

@@ -21,7 +21,7 @@ namespace hmpm {
 struct BodyLayout {
   std::vector<Vec3> positions;  ///< in the contract's numbering
   std::vector<double> volumes;  ///< initial volume per particle
-  std::int64_t count = 0;       ///< positions.size()
+  std::int64_t count = 0;       ///< how many (positions.size() when they are kept)
   /// The space the particles fill, per axis (sub-cells; each point's own
   /// cube for a points body); meaningless when count is 0.
   Vec3 lo{0, 0, 0}, hi{0, 0, 0};
@@ -29,8 +29,14 @@ struct BodyLayout {
   std::vector<std::pair<std::size_t, std::int64_t>> lost;
 };
 
+/// What body_layouts keeps: every position and volume, or only the counts,
+/// the filled extents and the losses (no per-particle storage: the checks
+/// and estimates that only count call it on million-particle jobs).
+enum class LayoutDetail { positions, counts };
+
 /// Every body's particles, in order, with overlaps given to the first body.
-std::vector<BodyLayout> body_layouts(const Problem& problem);
+std::vector<BodyLayout> body_layouts(const Problem& problem,
+                                     LayoutDetail detail = LayoutDetail::positions);
 
 /// Smallest cell size over the active axes, m.
 double min_cell_size(const Problem& problem);

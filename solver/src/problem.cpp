@@ -140,7 +140,8 @@ bool same_place(const Vec3& a, const Vec3& b, double tol) {
 
 }  // namespace
 
-std::vector<BodyLayout> body_layouts(const Problem& problem) {
+std::vector<BodyLayout> body_layouts(const Problem& problem, LayoutDetail detail) {
+  const bool store_all = detail == LayoutDetail::positions;
   std::vector<BodyLayout> layouts(problem.bodies.size());
   const double tol = fill_tolerance(problem);
   const int dim = problem.dimension;
@@ -153,6 +154,17 @@ std::vector<BodyLayout> body_layouts(const Problem& problem) {
   for (std::size_t b = 0; b < problem.bodies.size(); ++b) {
     const Body& body = problem.bodies[b];
     BodyLayout& layout = layouts[b];
+    // A points body's positions are always kept: later bodies test against them.
+    const bool store = store_all || body.points;
+    for (int a = 0; a < dim; ++a) {
+      layout.lo[a] = std::numeric_limits<double>::infinity();
+      layout.hi[a] = -std::numeric_limits<double>::infinity();
+    }
+    // The space filled: each particle's own cell (sub-cell, or the cube of
+    // its volume for a points body).
+    Vec3 half{0, 0, 0};
+    for (int a = 0; a < dim; ++a)
+      half[a] = 0.5 * cell_size(problem, a) / std::max(body.particles_per_cell, 1);
     std::vector<std::int64_t> lost(b, 0);
     auto keep = [&](const Vec3& x, double volume) {
       for (std::size_t e = 0; e < b; ++e) {
@@ -171,17 +183,31 @@ std::vector<BodyLayout> body_layouts(const Problem& problem) {
           return;
         }
       }
+      ++layout.count;
+      if (body.points) half.fill(0.5 * std::pow(std::max(volume, 0.0), 1.0 / dim));
+      for (int a = 0; a < dim; ++a) {
+        layout.lo[a] = std::min(layout.lo[a], x[a] - half[a]);
+        layout.hi[a] = std::max(layout.hi[a], x[a] + half[a]);
+      }
+      if (!store) return;
       layout.positions.push_back(x);
       layout.volumes.push_back(volume);
     };
     if (body.points) {
       const ParticleList& pl = *body.points;
+      layout.positions.reserve(pl.positions.size());
+      layout.volumes.reserve(pl.positions.size());
       for (std::size_t k = 0; k < pl.positions.size(); ++k)
         keep(pl.positions[k], k < pl.volumes.size() ? pl.volumes[k] : 0.0);
     } else {
       const std::array<std::vector<double>, 3> coords = lattice_coords(problem, body);
       const bool shaped = body.polygon || body.prism;
       const double v0 = cell_volume / std::pow(std::max(body.particles_per_cell, 1), dim);
+      if (store) {
+        const std::size_t most = coords[0].size() * coords[1].size() * coords[2].size();
+        layout.positions.reserve(most);
+        layout.volumes.reserve(most);
+      }
       for (double z : coords[2])
         for (double y : coords[1])
           for (double x : coords[0]) {
@@ -189,29 +215,16 @@ std::vector<BodyLayout> body_layouts(const Problem& problem) {
             if (!shaped || in_polygon_shape(body, x3, tol)) keep(x3, v0);
           }
     }
-    layout.count = static_cast<std::int64_t>(layout.positions.size());
     for (std::size_t e = 0; e < b; ++e)
       if (lost[e] > 0) layout.lost.emplace_back(e, lost[e]);
-    // The space filled: each particle's own cell (sub-cell, or the cube of
-    // its volume for a points body).
-    for (int a = 0; a < dim; ++a) {
-      layout.lo[a] = std::numeric_limits<double>::infinity();
-      layout.hi[a] = -std::numeric_limits<double>::infinity();
-    }
-    for (std::size_t k = 0; k < layout.positions.size(); ++k) {
-      const double half =
-          body.points ? 0.5 * std::pow(std::max(layout.volumes[k], 0.0), 1.0 / dim) : 0.0;
-      for (int a = 0; a < dim; ++a) {
-        const double ha =
-            body.points ? half : 0.5 * cell_size(problem, a) / std::max(body.particles_per_cell, 1);
-        layout.lo[a] = std::min(layout.lo[a], layout.positions[k][a] - ha);
-        layout.hi[a] = std::max(layout.hi[a], layout.positions[k][a] + ha);
-      }
-    }
     if (body.points) {
       sorted_points[b] = layout.positions;
       std::sort(sorted_points[b].begin(), sorted_points[b].end(),
                 [](const Vec3& p, const Vec3& q) { return p[0] < q[0]; });
+      if (!store_all) {
+        layout.positions = {};
+        layout.volumes = {};
+      }
     }
   }
   return layouts;
@@ -219,7 +232,7 @@ std::vector<BodyLayout> body_layouts(const Problem& problem) {
 
 std::int64_t count_particles(const Problem& problem) {
   std::int64_t n = 0;
-  for (const BodyLayout& l : body_layouts(problem)) n += l.count;
+  for (const BodyLayout& l : body_layouts(problem, LayoutDetail::counts)) n += l.count;
   return n;
 }
 
@@ -532,7 +545,7 @@ std::vector<ProblemIssue> problem_warnings(const Problem& problem) {
                   darcy_growth_advice(m, c);
     warnings.push_back({Location{"materials", m.name, "hydraulic"}, what});
   }
-  const std::vector<BodyLayout> layouts = body_layouts(problem);
+  const std::vector<BodyLayout> layouts = body_layouts(problem, LayoutDetail::counts);
   for (std::size_t b = 0; b < layouts.size(); ++b)
     for (const auto& [earlier, n] : layouts[b].lost)
       warnings.push_back(
@@ -605,7 +618,7 @@ std::vector<ProblemIssue> check_problem(const Problem& problem) {
       check_selection_polygon(problem, *problem.fluxes[i].polygon,
                               Location{"fluxes"} / i / "particles" / "polygon", issues);
   if (issues.size() > before_shapes) return issues;
-  const std::vector<BodyLayout> layouts = body_layouts(problem);
+  const std::vector<BodyLayout> layouts = body_layouts(problem, LayoutDetail::counts);
   for (std::size_t b = 0; b < problem.bodies.size(); ++b) {
     const Body& body = problem.bodies[b];
     const Location w = Location{"bodies"} / b;

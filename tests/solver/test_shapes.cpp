@@ -234,6 +234,37 @@ TEST(Overlap, PolygonsBoxesAndPointsNeverShareAPlace) {
               2 * area_bound({{1, 0}, {9, 0}, {7, 3}, {3, 3}}, 0.25));
 }
 
+// The checks and estimates lay out the bodies without keeping positions
+// (LayoutDetail::counts; a million-particle job calls them a dozen times):
+// the counts, filled extents and losses must be those of the full layout,
+// with a points body listed first so that later bodies test against it.
+TEST(Overlap, CountingLayoutAgreesWithTheFullOne) {
+  hmpm::Problem p = ground(20, 8);
+  hmpm::Body pts;
+  pts.points = hmpm::ParticleList{{{0.125, 0.125, 0}, {9.9, 3.9, 0}}, {0.0625, 0.01}};
+  p.bodies.push_back(pts);
+  hmpm::Body foundation;
+  foundation.box = {{0, 0, 0}, {10, 1, 0}};
+  p.bodies.push_back(foundation);
+  p.bodies.push_back(polygon_body({{1, 0}, {9, 0}, {7, 3}, {3, 3}}, 2));
+  ASSERT_TRUE(hmpm::check_problem(p).empty());
+  const auto full = hmpm::body_layouts(p);
+  const auto counted = hmpm::body_layouts(p, hmpm::LayoutDetail::counts);
+  ASSERT_EQ(full.size(), counted.size());
+  for (std::size_t b = 0; b < full.size(); ++b) {
+    EXPECT_EQ(counted[b].count, full[b].count) << b;
+    EXPECT_EQ(full[b].count, static_cast<std::int64_t>(full[b].positions.size())) << b;
+    EXPECT_TRUE(counted[b].positions.empty()) << b;
+    EXPECT_EQ(counted[b].lost, full[b].lost) << b;
+    for (int a = 0; a < 2; ++a) {
+      EXPECT_EQ(counted[b].lo[a], full[b].lo[a]) << b;
+      EXPECT_EQ(counted[b].hi[a], full[b].hi[a]) << b;
+    }
+  }
+  EXPECT_EQ(full[1].lost.size(), 1u);  // the foundation lost (0.125, 0.125) to the points
+  EXPECT_EQ(hmpm::count_particles(p), full[0].count + full[1].count + full[2].count);
+}
+
 TEST(PointsBody, ReproducesPositionsAndVolumes) {
   hmpm::Problem p = ground(20, 8);
   hmpm::Body b;

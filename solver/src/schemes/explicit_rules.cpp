@@ -21,7 +21,7 @@ namespace hmpm {
 std::vector<bool> materials_with_particles(const Problem& problem) {
   std::vector<bool> used(problem.materials.size(), false);
   bool any = false;
-  const std::vector<BodyLayout> layouts = body_layouts(problem);
+  const std::vector<BodyLayout> layouts = body_layouts(problem, LayoutDetail::counts);
   for (std::size_t b = 0; b < problem.bodies.size(); ++b) {
     const Body& body = problem.bodies[b];
     if (body.material < 0 || body.material >= static_cast<int>(used.size())) continue;
