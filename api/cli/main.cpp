@@ -223,9 +223,9 @@ int command_run(const std::vector<std::string>& args) {
     std::cerr << "hmpm: run " << hmpm::status_name(r.status) << ": " << r.message << "\n";
     return exit_run_failed;
   }
-  std::cout << "successful: " << r.steps << " steps of " << r.dt << " s, " << r.particles
-            << " particles, " << r.solve_seconds << " s (" << r.particle_steps_per_second
-            << " particle-steps/s); results in " << out << "\n";
+  std::cout << "successful: " << r.message << " (" << r.steps << " steps, first dt " << r.dt
+            << " s), " << r.particles << " particles, " << r.solve_seconds << " s ("
+            << r.particle_steps_per_second << " particle-steps/s); results in " << out << "\n";
   return exit_ok;
 }
 

@@ -222,7 +222,7 @@ struct MemoryModel {
 double profile_rows(const Problem& p) {
   const OutputRequest& o = p.output;
   if (o.profiles.empty() || !(o.profile_interval > 0)) return 0;
-  return std::floor(p.time.end / o.profile_interval + 1e-9) + 1;
+  return std::floor(stage_problem(p, stage_count(p) - 1).time.end / o.profile_interval + 1e-9) + 1;
 }
 
 /// Values of one profile sample: every component of every field of every point.
@@ -386,20 +386,27 @@ CostEstimate estimate_cost(const Problem& p, const Calibration& calibration) {
   c.nodes = to_count(nodes);
   const StableStep step = stable_step(p);
   c.dt = step.chosen;
-  const double steps = static_cast<double>(step.steps);
-  c.steps = step.steps;
+  // A staged job: the steps of every stage, to the last one's end.
+  double steps = static_cast<double>(step.steps);
+  double job_end = p.time.end;
+  for (std::size_t k = 1; k < stage_count(p); ++k) {
+    const Problem stage = stage_problem(p, k);
+    steps += static_cast<double>(std::max<std::int64_t>(1, stable_step(stage).steps));
+    job_end = stage.time.end;
+  }
+  c.steps = to_count(steps);
   c.particle_steps = to_count(static_cast<double>(c.particles) * steps);
   const OutputRequest& o = p.output;
   double rows = 0;
   if (!o.series_particles.empty() && !o.series_fields.empty())
-    rows = o.series_interval <= c.dt ? steps + 1
-                                     : std::floor(p.time.end / o.series_interval + 1e-9) + 1;
+    rows =
+        o.series_interval <= c.dt ? steps + 1 : std::floor(job_end / o.series_interval + 1e-9) + 1;
   c.series_rows = to_count(rows);
   const double snaps =
-      o.snapshot_interval > 0 ? std::floor(p.time.end / o.snapshot_interval + 1e-9) + 1 : 0;
+      o.snapshot_interval > 0 ? std::floor(job_end / o.snapshot_interval + 1e-9) + 1 : 0;
   c.snapshots = to_count(snaps);
   const double reaction_rows =
-      o.reactions_interval > 0 ? std::floor(p.time.end / o.reactions_interval + 1e-9) : 0;
+      o.reactions_interval > 0 ? std::floor(job_end / o.reactions_interval + 1e-9) : 0;
   c.reaction_rows = to_count(reaction_rows);
   const double reaction_values = static_cast<double>(p.boundaries.size()) * dim;
   double series_values = 0;

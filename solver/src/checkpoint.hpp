@@ -15,7 +15,14 @@
 //   series   array of sample times, u64 field count, one array per field
 //   reactions  array of sample times, u64 boundary count (0 when none are
 //            asked for), one array per boundary
+//   profiles f64 next profile time, u64 line count, per line its sample
+//            times and one array per field
+//   stages   u64 the stage in force (0: the first), the iteration counts of
+//            the stages before it (i64 nonlinear, linear, solves, cutbacks,
+//            i32 most in a step, array of that step's residuals)
 //   particles  every array of ParticleState::for_each_array, in its order
+//            (those of the stage in force: a resumed run first replays the
+//            stages' moves of bodies)
 //   scheme   TimeScheme::save (e.g. the semi-implicit solver's initial
 //            guess, the quasi-static step plan and counters)
 //   trailer  u64 FNV-1a hash of everything before it
@@ -37,7 +44,9 @@
 namespace hmpm::checkpoint {
 
 inline constexpr char magic[8] = {'H', 'M', 'P', 'M', 'C', 'K', 'P', 'T'};
-inline constexpr std::uint32_t version = 3;  ///< 2: reactions; 3: plastic strain, profiles
+/// 2: reactions; 3: plastic strain, profiles; 4: stages (the stage in
+/// force, the iterations of those before, particle ids)
+inline constexpr std::uint32_t version = 4;
 
 /// FNV-1a, 64 bits, continuing from `h`.
 inline std::uint64_t fnv1a(const char* data, std::size_t n,

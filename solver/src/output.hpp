@@ -2,6 +2,7 @@
 // fields and the time series of selected particles (internal).
 #pragma once
 
+#include <limits>
 #include <vector>
 
 #include "simulation.hpp"
@@ -84,7 +85,15 @@ void Simulation<Dim, Shape>::sample_series(Series& series, double t) const {
   for (std::size_t f = 0; f < series.fields.size(); ++f) {
     std::vector<double>& out = series.values[f];
     for (std::int64_t pi : series.particles) {
-      const auto p = static_cast<std::size_t>(pi);
+      // A staged job numbers particles as the job does; one out of the run
+      // (a body not added yet, or removed) has no values: NaN (null).
+      const std::int64_t slot = slot_.empty() ? pi : slot_[static_cast<std::size_t>(pi)];
+      if (slot < 0) {
+        out.insert(out.end(), static_cast<std::size_t>(field_components(series.fields[f], Dim)),
+                   std::numeric_limits<double>::quiet_NaN());
+        continue;
+      }
+      const auto p = static_cast<std::size_t>(slot);
       switch (series.fields[f]) {
         case Field::position:
           for (int a = 0; a < Dim; ++a) out.push_back(particles_.x[p][a]);

@@ -300,6 +300,48 @@ double min_cell_size(const Problem& problem) {
   return h;
 }
 
+Problem stage_problem(const Problem& problem, std::size_t k) {
+  Problem out = problem;
+  out.stages.clear();
+  for (std::size_t i = 1; i <= k && i <= problem.stages.size(); ++i) {
+    const Stage& s = problem.stages[i - 1];
+    const double previous_end = out.time.end;
+    if (s.boundaries) out.boundaries = *s.boundaries;
+    if (s.tractions) out.tractions = *s.tractions;
+    if (s.fluxes) out.fluxes = *s.fluxes;
+    if (s.gravity) out.gravity = *s.gravity;
+    if (s.time) out.time = *s.time;
+    if (s.local_damping) out.local_damping = *s.local_damping;
+    out.time.start = previous_end;
+    out.time.end = s.end;
+  }
+  return out;
+}
+
+std::vector<bool> stage_bodies(const Problem& problem, std::size_t k) {
+  std::vector<bool> in(problem.bodies.size(), true);
+  auto set = [&](const std::vector<int>& bodies, bool value) {
+    for (int b : bodies)
+      if (b >= 0 && static_cast<std::size_t>(b) < in.size())
+        in[static_cast<std::size_t>(b)] = value;
+  };
+  for (const Stage& s : problem.stages) set(s.add_bodies, false);
+  for (std::size_t i = 1; i <= k && i <= problem.stages.size(); ++i) {
+    set(problem.stages[i - 1].add_bodies, true);
+    set(problem.stages[i - 1].remove_bodies, false);
+  }
+  return in;
+}
+
+Problem initial_ground(const Problem& problem) {
+  const std::vector<bool> in = stage_bodies(problem, 0);
+  Problem out = problem;
+  out.bodies.clear();
+  for (std::size_t b = 0; b < problem.bodies.size(); ++b)
+    if (in[b]) out.bodies.push_back(problem.bodies[b]);
+  return out;
+}
+
 StableStep stable_step(const Problem& problem) {
   return scheme_rules(problem).stable_step(problem);
 }
@@ -565,6 +607,81 @@ std::vector<ProblemIssue> problem_warnings(const Problem& problem) {
   return warnings;
 }
 
+namespace {
+
+/// The stages of a staged job: ends in order, body indices that exist and
+/// are in the run when removed (absent when added), and every stage's own
+/// Problem runnable: its issues, where the top level does not have them
+/// already, at the stage (a list it sets at its own path; one in force
+/// from before at the stage, naming it).
+void check_stages(const Problem& problem, std::vector<ProblemIssue>& issues) {
+  if (problem.stages.empty()) return;
+  std::vector<std::string> top;
+  for (const ProblemIssue& i : issues) top.push_back(i.where.text() + ": " + i.message);
+  double previous = problem.time.end;
+  for (std::size_t i = 0; i < problem.stages.size(); ++i) {
+    const Stage& st = problem.stages[i];
+    const Location at = Location{"stages"} / i;
+    if (!(st.end > previous))
+      issues.push_back({at / "end", "must be after the end of the stage before (" +
+                                        format_significant(previous, 6) + " s)"});
+    previous = std::max(previous, st.end);
+    const std::vector<bool> before = stage_bodies(problem, i);
+    auto bodies = [&](const std::vector<int>& list, const char* key, bool adding) {
+      for (std::size_t k = 0; k < list.size(); ++k) {
+        const int b = list[k];
+        if (b < 0 || static_cast<std::size_t>(b) >= problem.bodies.size()) {
+          issues.push_back({at / key / k, "body " + std::to_string(b) +
+                                              " does not exist; there are " +
+                                              std::to_string(problem.bodies.size()) + " bodies"});
+          continue;
+        }
+        const bool in = before[static_cast<std::size_t>(b)];
+        if (adding && in)
+          issues.push_back({at / key / k, "body " + std::to_string(b) +
+                                              " is in the run already (added by an earlier "
+                                              "stage); a body can be added once"});
+        if (!adding && !in)
+          issues.push_back({at / key / k, "body " + std::to_string(b) +
+                                              " is not in the run at this stage (removed "
+                                              "before, or not added yet)"});
+      }
+    };
+    bodies(st.add_bodies, "add_bodies", true);
+    bodies(st.remove_bodies, "remove_bodies", false);
+    const std::vector<bool> after = stage_bodies(problem, i + 1);
+    if (std::none_of(after.begin(), after.end(), [](bool b) { return b; }))
+      issues.push_back({at / "remove_bodies", "leaves no body in the run"});
+  }
+  if (!issues.empty()) return;
+  for (std::size_t i = 0; i < problem.stages.size(); ++i) {
+    const Stage& st = problem.stages[i];
+    const Location at = Location{"stages"} / i;
+    auto sets = [&](const std::string& key) {
+      return (key == "boundaries" && st.boundaries) || (key == "tractions" && st.tractions) ||
+             (key == "fluxes" && st.fluxes) || (key == "time" && st.time) ||
+             (key == "gravity" && st.gravity) || (key == "local_damping" && st.local_damping);
+    };
+    for (const ProblemIssue& issue : check_problem(stage_problem(problem, i + 1))) {
+      const std::string text = issue.where.text() + ": " + issue.message;
+      if (std::find(top.begin(), top.end(), text) != top.end()) continue;
+      const std::string& key = issue.where.parts.empty() ? std::string() : issue.where.parts[0];
+      if (key == "time" && issue.where.parts.size() > 1 && issue.where.parts[1] == "end") {
+        issues.push_back({at / "end", issue.message});
+      } else if (sets(key)) {
+        Location where = at;
+        for (const std::string& part : issue.where.parts) where = where / part;
+        issues.push_back({where, issue.message});
+      } else {
+        issues.push_back({at, "with " + issue.where.text() +
+                                  " in force from the stage before: " + issue.message});
+      }
+    }
+  }
+}
+
+}  // namespace
+
 std::vector<ProblemIssue> check_problem(const Problem& problem) {
   std::vector<ProblemIssue> issues;
   auto add = [&](Location where, std::string msg) {
@@ -689,7 +806,11 @@ std::vector<ProblemIssue> check_problem(const Problem& problem) {
   }
   if (!out.profiles.empty() && !(out.profile_interval > 0))
     add({"output", "profiles", "interval"}, "must be > 0");
-  for (ProblemIssue& issue : check_geostatic(problem)) issues.push_back(std::move(issue));
+  const bool adds = std::any_of(problem.stages.begin(), problem.stages.end(),
+                                [](const Stage& st) { return !st.add_bodies.empty(); });
+  for (ProblemIssue& issue : check_geostatic(adds ? initial_ground(problem) : problem))
+    issues.push_back(std::move(issue));
+  check_stages(problem, issues);
   return issues;
 }
 

@@ -8,6 +8,8 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <stdexcept>
+#include <string>
 #include <type_traits>
 #include <vector>
 
@@ -21,15 +23,18 @@ namespace hmpm {
 
 template <int Dim, class Shape>
 Simulation<Dim, Shape>::Simulation(const Problem& problem, const RunOptions& options)
-    : problem_(problem), interrupt_(options.cancel, options.wall_time_limit_s) {
+    : job_(problem),
+      problem_(stage_problem(problem, 0)),
+      interrupt_(options.cancel, options.wall_time_limit_s) {
   setup_grid();
   setup_materials();
   setup_particles();
+  setup_stages();
   interrupt_.stage("compiling boundaries and tractions");
   interrupt_.check();
   constraints_ = compile_constraints<Dim>(problem_, grid_, grid_max_, fluid_);
-  tractions_ = compile_tractions<Dim>(problem_, particles_, grid_);
-  if (fluid_) fluxes_ = compile_fluxes<Dim>(problem_, particles_, grid_);
+  tractions_ = compile_tractions<Dim>(problem_, particles_, particles_.volume, grid_);
+  if (fluid_) fluxes_ = compile_fluxes<Dim>(problem_, particles_, particles_.volume, grid_);
   if (problem_.output.reactions_interval > 0) setup_reactions();
   setup_geostatic();
   interrupt_.check();
@@ -65,7 +70,7 @@ void Simulation<Dim, Shape>::setup_materials() {
     state_variables_ =
         std::max(state_variables_,
                  state_variable_count(constants_[static_cast<std::size_t>(body.material)].model));
-  for (const ProblemIssue& w : problem_warnings(problem_))
+  for (const ProblemIssue& w : problem_warnings(job_))
     warnings_.push_back(w.where.text().append(": ").append(w.message));
   for (int a = 0; a < Dim; ++a) gravity_[a] = problem_.gravity[a];
 }
@@ -117,6 +122,26 @@ void Simulation<Dim, Shape>::setup_particles() {
   }
 }
 
+template <int Dim, class Shape>
+void Simulation<Dim, Shape>::setup_stages() {
+  job_particles_ = static_cast<std::int64_t>(particles_.size());
+  bool moves = false;
+  for (const Stage& s : job_.stages)
+    moves = moves || !s.add_bodies.empty() || !s.remove_bodies.empty();
+  if (!moves) return;
+  interrupt_.stage("setting the stages' bodies aside");
+  std::int64_t first = 0;
+  for (const BodyLayout& l : body_layouts(problem_, LayoutDetail::counts)) {
+    body_begin_.push_back(first);
+    first += l.count;
+  }
+  particles_.id.resize(particles_.size());
+  for (std::size_t p = 0; p < particles_.size(); ++p)
+    particles_.id[p] = static_cast<std::int64_t>(p);
+  dormant_.resize(0, fluid_, std::is_same_v<Shape, shape::Gimp>, state_variables_, plastic_);
+  move_stage_particles(0);
+}
+
 /// Geostatic initial state (Problem::initial_state.geostatic): effective
 /// stress and pore pressure from the layered closed form at every particle.
 /// The reported pressure is the closed form; the transported pressure state
@@ -130,7 +155,16 @@ template <int Dim, class Shape>
 void Simulation<Dim, Shape>::setup_geostatic() {
   if (!problem_.initial_state.geostatic) return;
   interrupt_.stage("computing the geostatic state");
-  const GeostaticState g = geostatic_state(problem_, &interrupt_);
+  // Without the bodies a stage adds (their particles wait in dormant_).
+  const GeostaticState g =
+      geostatic_state(body_begin_.empty() ? problem_ : initial_ground(problem_), &interrupt_);
+  if (g.vertical.size() != particles_.size())
+    throw std::invalid_argument(
+        "the geostatic state has " + std::to_string(g.vertical.size()) +
+        " particles where the "
+        "first stage has " +
+        std::to_string(particles_.size()) +
+        ": a body a stage adds overlaps the ground; make them meet without overlapping");
   for (std::size_t p = 0; p < particles_.size(); ++p) {
     geostatic_voigt(g, p, particles_.stress[p].data());
     if (fluid_ && constants_[particles_.material[p]].saturated) {

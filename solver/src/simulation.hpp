@@ -85,6 +85,16 @@ class Simulation {
   void setup_materials();
   void setup_particles();
   void setup_geostatic();
+  /// Staged jobs: the particles of bodies a stage adds leave the run until
+  /// then (set-up, before the geostatic state).
+  void setup_stages();
+
+  // ------------------------------------------------------------ stages (stages.hpp)
+  /// Makes stage k the one in force: its Problem, its bodies' particles,
+  /// the constraints, loads and reactions compiled for them.
+  void enter_stage(std::size_t k);
+  /// The particles of the bodies in force at stage k, and slot_ to match.
+  void move_stage_particles(std::size_t k);
   void balance_initial_pressure_state();
 
   // ------------------------------------------------------------ phases (phases/)
@@ -251,8 +261,18 @@ class Simulation {
   void fill_snapshot(Snapshot& snap, const std::vector<Field>& fields) const;
   void sample_series(Series& series, double t) const;
 
-  const Problem& problem_;
-  SetupInterrupt interrupt_;  ///< set-up's stop checks; its start is the run's start
+  const Problem& job_;  ///< the job as given, every stage (Problem::stages)
+  /// The Problem in force: stage_problem(job_, stage_) (stages.hpp).
+  Problem problem_;
+  std::size_t stage_ = 0;
+  // Stages that add or remove bodies: the particles of bodies not in the
+  // run (yet, or any more), each particle's slot by its job index (-1: not
+  // in the run), the first job index of each body.
+  ParticleState<Dim> dormant_;
+  std::vector<std::int64_t> slot_;
+  std::vector<std::int64_t> body_begin_;
+  std::int64_t job_particles_ = 0;  ///< particles of every body of the job
+  SetupInterrupt interrupt_;        ///< set-up's stop checks; its start is the run's start
   GridState<Dim> grid_;
   ParticleState<Dim> particles_;
   std::vector<MaterialConstants> constants_;

@@ -15,4 +15,5 @@
 #include "schemes/semi_implicit_scheme.hpp"
 #include "setup.hpp"
 #include "simulation.hpp"
+#include "stages.hpp"
 #include "time_loop.hpp"

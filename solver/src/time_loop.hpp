@@ -11,6 +11,7 @@
 #include <cstdint>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -42,44 +43,51 @@ std::unique_ptr<TimeScheme> make_scheme(Simulation<Dim, Shape>& sim, const Probl
   return std::make_unique<ExplicitScheme<Dim, Shape>>(sim);
 }
 
+/// Adds a stage's iteration counts to the job's (the worst step overall
+/// keeps its residual history).
+inline void add_iterations(RunResult::Iterations& into, const RunResult::Iterations& from) {
+  into.nonlinear += from.nonlinear;
+  into.linear += from.linear;
+  into.solves += from.solves;
+  into.cutbacks += from.cutbacks;
+  if (from.max_nonlinear > into.max_nonlinear) {
+    into.max_nonlinear = from.max_nonlinear;
+    into.worst_residuals = from.worst_residuals;
+  }
+}
+
 template <int Dim, class Shape>
 RunResult Simulation<Dim, Shape>::run(const RunOptions& options) {
   using Clock = std::chrono::steady_clock;
   RunResult result;
-  const std::unique_ptr<TimeScheme> scheme = make_scheme(*this, problem_);
-  TimeScheme& time_scheme = *scheme;  // the loop sees the interface only
-  stable_ = time_scheme.stable_step(problem_);
-  result.scheme = scheme_name(problem_.time.scheme);
-  // Fixed steps: step n ends at (n + 1) dt, the last at `end` exactly.
-  // Varying steps (quasi_static growth): the scheme says each length and
-  // `total` is its estimate, for progress only.
-  const bool fixed = stable_.fixed;
-  const double dt = stable_.chosen;
-  const double end = problem_.time.end;
-  std::int64_t total = std::max<std::int64_t>(1, stable_.steps);
+  const std::size_t stages = stage_count(job_);
+  // Every stage's estimated steps (progress); a stage's scheme says its own.
+  std::int64_t total = 0;
+  for (std::size_t k = 0; k < stages; ++k)
+    total += std::max<std::int64_t>(1, stable_step(stage_problem(job_, k)).steps);
+  const double end = stage_problem(job_, stages - 1).time.end;  // the job's end
+  result.scheme = scheme_name(job_.time.scheme);
   double min_mass = std::numeric_limits<double>::infinity();
   for (double m : particles_.mass) min_mass = std::min(min_mass, m);
-  mass_tolerance_ = particles_.size() ? 1e-12 * min_mass : 0.0;
+  for (double m : dormant_.mass) min_mass = std::min(min_mass, m);
+  mass_tolerance_ = job_particles_ > 0 ? 1e-12 * min_mass : 0.0;
   // Threads: every core when asked for <= 0, but at least
   // min_particles_per_thread particles each.
   int threads = options.threads > 0
                     ? options.threads
                     : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
-  threads = static_cast<int>(
-      std::clamp<std::int64_t>(static_cast<std::int64_t>(particles_.size()) /
-                                   std::max<std::int64_t>(1, options.min_particles_per_thread),
-                               1, threads));
+  threads = static_cast<int>(std::clamp<std::int64_t>(
+      job_particles_ / std::max<std::int64_t>(1, options.min_particles_per_thread), 1, threads));
   setup_threads(threads);
 
-  result.dt = dt;
-  result.particles = static_cast<std::int64_t>(particles_.size());
+  result.particles = job_particles_;
   result.nodes = grid_.count;
-  result.state_bytes = particles_.bytes() + grid_.bytes() * threads;
+  result.state_bytes = particles_.bytes() + dormant_.bytes() + grid_.bytes() * threads;
   result.threads = threads;
   result.warnings = warnings_;
 
   // Output set-up.
-  const OutputRequest& out = problem_.output;
+  const OutputRequest& out = job_.output;
   Series& series = result.series;
   series.dimension = Dim;
   // A series (or a profile) of these particles and fields, empty.
@@ -89,10 +97,14 @@ RunResult Simulation<Dim, Shape>::run(const RunOptions& options) {
     s.particles = particles;
     s.fields = fields;
     s.values.resize(fields.size());
+    const std::vector<Vec3> x0 = slot_.empty() ? std::vector<Vec3>{} : initial_positions(job_);
     for (std::int64_t pi : particles) {
-      Vec3 x0{0, 0, 0};
-      for (int a = 0; a < Dim; ++a) x0[a] = particles_.x[static_cast<std::size_t>(pi)][a];
-      s.initial_positions.push_back(x0);
+      Vec3 at{0, 0, 0};
+      if (slot_.empty())
+        for (int a = 0; a < Dim; ++a) at[a] = particles_.x[static_cast<std::size_t>(pi)][a];
+      else
+        at = x0[static_cast<std::size_t>(pi)];
+      s.initial_positions.push_back(at);
     }
   };
   const bool want_series = !out.series_particles.empty() && !out.series_fields.empty();
@@ -106,12 +118,18 @@ RunResult Simulation<Dim, Shape>::run(const RunOptions& options) {
       start_series(profiles[l], out.profiles[l].particles, out.profiles[l].fields);
   }
   double next_profile = out.profile_interval;
-  // Reactions: one vector per boundary per sample, the first at t =
-  // interval (a step's reaction needs the step).
+  // Reactions: one vector per boundary (the most any stage has) per sample,
+  // the first at t = interval (a step's reaction needs the step). A boundary
+  // a stage does not have exerts no force.
   Reactions& reactions = result.reactions;
   reactions.dimension = Dim;
   const bool want_reactions = out.reactions_interval > 0;
-  if (want_reactions) reactions.force.resize(problem_.boundaries.size());
+  if (want_reactions) {
+    std::size_t most = job_.boundaries.size();
+    for (const Stage& st : job_.stages)
+      if (st.boundaries) most = std::max(most, st.boundaries->size());
+    reactions.force.resize(most);
+  }
   double next_reaction = out.reactions_interval;
   std::vector<Field> snapshot_fields = out.snapshot_fields;
   if (snapshot_fields.empty())
@@ -128,16 +146,18 @@ RunResult Simulation<Dim, Shape>::run(const RunOptions& options) {
   };
   double next_series = out.series_interval > 0 ? out.series_interval : 0.0;
   double next_snapshot = out.snapshot_interval;
-  const double eps_t = 1e-9 * dt;
   std::int64_t n = 0;
   double t = 0.0;
   double seconds_before = 0.0;  // loop wall time of the runs before a resume
+  std::size_t first_stage = 0;
+  RunResult::Iterations done_iterations;  // of the stages before the one in force
+  std::optional<checkpoint::Reader> resume;
   if (options.resume) {
     // Everything the loop carries, as the checkpoint left it after step n
     // (the initial positions of the series come from the set-up above).
-    checkpoint::Reader r(*options.resume, checkpoint::body_end(*options.resume));
+    checkpoint::Reader& r = resume.emplace(*options.resume, checkpoint::body_end(*options.resume));
     const checkpoint::Header h =
-        checkpoint::read_header(r, *options.resume, problem_, options.checkpoint_key);
+        checkpoint::read_header(r, *options.resume, job_, options.checkpoint_key);
     n = h.step;
     t = h.time;
     total = h.total;
@@ -171,14 +191,20 @@ RunResult Simulation<Dim, Shape>::run(const RunOptions& options) {
       r.array(s.time, -1, "profile times");
       for (std::vector<double>& v : s.values) r.array(v, -1, "profile values");
     }
+    first_stage = static_cast<std::size_t>(r.pod<std::uint64_t>());
+    if (first_stage >= stages)
+      throw std::invalid_argument("the checkpoint is in stage " + std::to_string(first_stage) +
+                                  " of a job with " + std::to_string(stages));
+    done_iterations.nonlinear = r.pod<std::int64_t>();
+    done_iterations.linear = r.pod<std::int64_t>();
+    done_iterations.solves = r.pod<std::int64_t>();
+    done_iterations.cutbacks = r.pod<std::int64_t>();
+    done_iterations.max_nonlinear = r.pod<int>();
+    r.array(done_iterations.worst_residuals, -1, "residuals");
+    // The particles of the stage it was in, then their state.
+    if (first_stage != stage_) enter_stage(first_stage);
     particles_.for_each_array(
         [&](auto& a) { r.array(a, static_cast<std::int64_t>(a.size()), "particle array"); });
-    time_scheme.load(r);
-    if (r.position() != checkpoint::body_end(*options.resume))
-      throw std::invalid_argument(
-          "the checkpoint has " +
-          std::to_string(checkpoint::body_end(*options.resume) - r.position()) +
-          " bytes more than this run's state");
   } else {
     if (want_series) sample_series(series, 0.0);
     for (Series& s : profiles) sample_series(s, 0.0);
@@ -191,8 +217,9 @@ RunResult Simulation<Dim, Shape>::run(const RunOptions& options) {
   const bool want_checkpoints = options.on_checkpoint && options.checkpoint_interval_s > 0;
   Checkpoint ckpt;
   std::int64_t checkpointed = n;  // steps done at the last checkpoint (or the resume)
-  // The state after `done` steps (t the time reached).
-  auto write_checkpoint = [&](std::int64_t done, Clock::time_point now) {
+  // The state after `done` steps (t the time reached), in the stage in
+  // force, whose scheme is `scheme`.
+  auto write_checkpoint = [&](std::int64_t done, Clock::time_point now, const TimeScheme& scheme) {
     checkpointed = done;
     ckpt.step = done;
     ckpt.time = t;
@@ -200,10 +227,10 @@ RunResult Simulation<Dim, Shape>::run(const RunOptions& options) {
     checkpoint::Writer w(ckpt.bytes);
     checkpoint::Header h;
     h.dimension = Dim;
-    h.shape = static_cast<std::uint32_t>(problem_.shape_function);
-    h.scheme = static_cast<std::uint32_t>(problem_.time.scheme);
-    h.particles = static_cast<std::int64_t>(particles_.size());
-    h.fingerprint = checkpoint::fingerprint(problem_, options.checkpoint_key);
+    h.shape = static_cast<std::uint32_t>(job_.shape_function);
+    h.scheme = static_cast<std::uint32_t>(job_.time.scheme);
+    h.particles = job_particles_;
+    h.fingerprint = checkpoint::fingerprint(job_, options.checkpoint_key);
     h.threads = threads;
     h.step = done;
     h.time = t;
@@ -226,8 +253,15 @@ RunResult Simulation<Dim, Shape>::run(const RunOptions& options) {
       w.array(s.time);
       for (const std::vector<double>& v : s.values) w.array(v);
     }
+    w.pod(static_cast<std::uint64_t>(stage_));
+    w.pod(done_iterations.nonlinear);
+    w.pod(done_iterations.linear);
+    w.pod(done_iterations.solves);
+    w.pod(done_iterations.cutbacks);
+    w.pod(done_iterations.max_nonlinear);
+    w.array(done_iterations.worst_residuals);
     particles_.for_each_array([&](const auto& a) { w.array(a); });
-    time_scheme.save(w);
+    scheme.save(w);
     checkpoint::finish(w);
     options.on_checkpoint(ckpt);
   };
@@ -241,115 +275,159 @@ RunResult Simulation<Dim, Shape>::run(const RunOptions& options) {
     pr.fraction = std::clamp(t / end, 0.0, 1.0);
     options.on_progress(pr);
   };
-
-  // Plausibility of the state (run_watch.hpp): about 500 checks per run.
-  RunWatch<Dim> watch(problem_, constants_);
-  const std::int64_t watch_stride = std::max<std::int64_t>(1, total / 500);
-  std::int64_t watched = -1;  // the step count at the last check
+  // "stage 'excavation' (2 of 3), " in messages of staged jobs.
+  auto stage_text = [&]() -> std::string {
+    if (stages == 1) return "";
+    const std::string& name = stage_ == 0 ? job_.first_stage_name : job_.stages[stage_ - 1].name;
+    return "stage '" + name + "' (" + std::to_string(stage_ + 1) + " of " + std::to_string(stages) +
+           "), ";
+  };
 
   result.status = RunStatus::successful;
-  for (; fixed ? n < total : t < end; ++n) {
-    if (options.cancel && options.cancel->load(std::memory_order_relaxed)) {
-      // A last checkpoint, so that a run stopped on purpose (a server
-      // shutting down) resumes where it stopped.
-      if (want_checkpoints && n > checkpointed) write_checkpoint(n, Clock::now());
-      result.status = RunStatus::cancelled;
-      result.message = "cancelled at step " + std::to_string(n) + " (t = " + number(t) + " s)";
-      break;
+  for (std::size_t k = first_stage; k < stages && result.status == RunStatus::successful; ++k) {
+    if (k != stage_) enter_stage(k);
+    const std::unique_ptr<TimeScheme> scheme = make_scheme(*this, problem_);
+    TimeScheme& time_scheme = *scheme;  // the loop sees the interface only
+    stable_ = time_scheme.stable_step(problem_);
+    if (resume) {
+      time_scheme.load(*resume);
+      if (resume->position() != checkpoint::body_end(*options.resume))
+        throw std::invalid_argument(
+            "the checkpoint has " +
+            std::to_string(checkpoint::body_end(*options.resume) - resume->position()) +
+            " bytes more than this run's state");
+      resume.reset();
     }
-    double t_new;
-    if (fixed) {
-      t_new = (n + 1 == total) ? end : static_cast<double>(n + 1) * dt;
-    } else {
-      // A step that would leave less than a hundredth of itself before
-      // `end` is stretched to end there.
-      const double h = time_scheme.next_dt(t);
-      t_new = t + h >= end - 0.01 * h ? end : t + h;
-      if (n + 1 >= total) total = n + 2;
-    }
-    // Load and boundary formulas are checked at the step's end time before
-    // the step uses them (the start's was checked by the step before, or
-    // below for t = 0): a NaN there is reported as the formula's, not as the
-    // divergence it would cause.
-    reactions_due_ = want_reactions && t_new >= next_reaction - eps_t;
-    if ((n > 0 || loads_finite_at(t)) && loads_finite_at(t_new)) time_scheme.step(t, t_new - t);
-    if (failed_) {
-      std::ostringstream where;
-      if (failure_particle_ >= 0) {  // -1: a failure of the run, not of a particle
-        const auto p = static_cast<std::size_t>(failure_particle_);
-        where << ", particle " << failure_particle_ << " at (";
-        for (int a = 0; a < Dim; ++a) where << (a ? ", " : "") << number(particles_.x[p][a]);
-        where << ")";
+    if (k == 0) result.dt = stable_.chosen;
+    // Fixed steps: step j of the stage ends at start + (j + 1) dt, the last
+    // at the stage's end exactly. Varying steps (quasi_static growth): the
+    // scheme says each length.
+    const bool fixed = stable_.fixed;
+    const double dt = stable_.chosen;
+    const double t0 = problem_.time.start, stage_end = problem_.time.end;
+    const std::int64_t steps = std::max<std::int64_t>(1, stable_.steps);
+    const double eps_t = 1e-9 * dt;
+    std::int64_t j = fixed ? std::llround((t - t0) / dt) : 0;  // steps done in this stage
+
+    // Plausibility of the state (run_watch.hpp): about 500 checks per stage.
+    RunWatch<Dim> watch(problem_, constants_);
+    const std::int64_t watch_stride = std::max<std::int64_t>(1, steps / 500);
+    std::int64_t watched = -1;  // the step count at the last check
+
+    for (; fixed ? j < steps : t < stage_end; ++n, ++j) {
+      if (options.cancel && options.cancel->load(std::memory_order_relaxed)) {
+        // A last checkpoint, so that a run stopped on purpose (a server
+        // shutting down) resumes where it stopped.
+        if (want_checkpoints && n > checkpointed) write_checkpoint(n, Clock::now(), time_scheme);
+        result.status = RunStatus::cancelled;
+        result.message = "cancelled " + stage_text() + "at step " + std::to_string(n) +
+                         " (t = " + number(t) + " s)";
+        break;
       }
-      result.status = RunStatus::failed;
-      result.message = "step " + std::to_string(n + 1) + " (t = " + number(t_new) + " s)" +
-                       where.str() + ": " + failure_ + ". What to change: " + failure_hint_ + ".";
-      t = t_new;
-      ++n;
-      break;
-    }
-    t = t_new;
-    if (watch.active() && (n + 1) % watch_stride == 0) {
-      watch.check(particles_, t);
-      watched = n + 1;
-    }
-    if (want_series && (out.series_interval <= 0 || t >= next_series - eps_t)) {
-      sample_series(series, t);
-      if (out.series_interval > 0)
-        while (next_series <= t + eps_t) next_series += out.series_interval;
-    }
-    if (reactions_due_) {
-      reactions.time.push_back(t);
-      for (std::size_t b = 0; b < reactions.force.size(); ++b)
-        for (int a = 0; a < Dim; ++a) reactions.force[b].push_back(reaction_[b][a]);
-      while (next_reaction <= t + eps_t) next_reaction += out.reactions_interval;
-    }
-    if (want_profiles && t >= next_profile - eps_t) {
-      for (Series& s : profiles) sample_series(s, t);
-      while (next_profile <= t + eps_t) next_profile += out.profile_interval;
-    }
-    if (want_snapshots && t >= next_snapshot - eps_t) {
-      take_snapshot(t);
-      while (next_snapshot <= t + eps_t) next_snapshot += out.snapshot_interval;
-    }
-    const auto now = Clock::now();
-    if (std::chrono::duration<double>(now - last_progress).count() >= options.progress_interval_s) {
-      last_progress = now;
-      report(n + 1, t);
-      if (options.wall_time_limit_s > 0 &&
-          seconds_before + std::chrono::duration<double>(now - interrupt_.start()).count() >
-              options.wall_time_limit_s) {  // set-up counts too
+      double t_new;
+      if (fixed) {
+        t_new = (j + 1 == steps) ? stage_end : t0 + static_cast<double>(j + 1) * dt;
+      } else {
+        // A step that would leave less than a hundredth of itself before
+        // the stage's end is stretched to end there.
+        const double h = time_scheme.next_dt(t);
+        t_new = t + h >= stage_end - 0.01 * h ? stage_end : t + h;
+        if (n + 1 >= total) total = n + 2;
+      }
+      // Load and boundary formulas are checked at the step's end time before
+      // the step uses them (the start's was checked by the step before, or
+      // below at a stage's start): a NaN there is reported as the formula's,
+      // not as the divergence it would cause.
+      reactions_due_ = want_reactions && t_new >= next_reaction - eps_t;
+      if ((j > 0 || loads_finite_at(t)) && loads_finite_at(t_new)) time_scheme.step(t, t_new - t);
+      if (failed_) {
+        std::ostringstream where;
+        if (failure_particle_ >= 0) {  // -1: a failure of the run, not of a particle
+          const auto p = static_cast<std::size_t>(failure_particle_);
+          where << ", particle " << (particles_.id.empty() ? failure_particle_ : particles_.id[p])
+                << " at (";
+          for (int a = 0; a < Dim; ++a) where << (a ? ", " : "") << number(particles_.x[p][a]);
+          where << ")";
+        }
         result.status = RunStatus::failed;
-        result.message = "wall-time limit of " + number(options.wall_time_limit_s) +
-                         " s reached at step " + std::to_string(n + 1) + " of " +
-                         std::to_string(total) + " (t = " + number(t) +
-                         " s). What to change: shorten time.end, coarsen the grid, use fewer "
-                         "particles per cell, or ask for a longer limit.";
+        result.message = stage_text() + "step " + std::to_string(n + 1) + " (t = " + number(t_new) +
+                         " s)" + where.str() + ": " + failure_ +
+                         ". What to change: " + failure_hint_ + ".";
+        t = t_new;
         ++n;
         break;
       }
+      t = t_new;
+      if (watch.active() && (j + 1) % watch_stride == 0) {
+        watch.check(particles_, t);
+        watched = j + 1;
+      }
+      if (want_series && (out.series_interval <= 0 || t >= next_series - eps_t)) {
+        sample_series(series, t);
+        if (out.series_interval > 0)
+          while (next_series <= t + eps_t) next_series += out.series_interval;
+      }
+      if (reactions_due_) {
+        reactions.time.push_back(t);
+        for (std::size_t b = 0; b < reactions.force.size(); ++b)
+          for (int a = 0; a < Dim; ++a)
+            reactions.force[b].push_back(b < reaction_.size() ? reaction_[b][a] : 0.0);
+        while (next_reaction <= t + eps_t) next_reaction += out.reactions_interval;
+      }
+      if (want_profiles && t >= next_profile - eps_t) {
+        for (Series& s : profiles) sample_series(s, t);
+        while (next_profile <= t + eps_t) next_profile += out.profile_interval;
+      }
+      if (want_snapshots && t >= next_snapshot - eps_t) {
+        take_snapshot(t);
+        while (next_snapshot <= t + eps_t) next_snapshot += out.snapshot_interval;
+      }
+      const auto now = Clock::now();
+      if (std::chrono::duration<double>(now - last_progress).count() >=
+          options.progress_interval_s) {
+        last_progress = now;
+        report(n + 1, t);
+        if (options.wall_time_limit_s > 0 &&
+            seconds_before + std::chrono::duration<double>(now - interrupt_.start()).count() >
+                options.wall_time_limit_s) {  // set-up counts too
+          result.status = RunStatus::failed;
+          result.message = "wall-time limit of " + number(options.wall_time_limit_s) +
+                           " s reached " + stage_text() + "at step " + std::to_string(n + 1) +
+                           " of " + std::to_string(total) + " (t = " + number(t) +
+                           " s). What to change: shorten time.end, coarsen the grid, use fewer "
+                           "particles per cell, or ask for a longer limit.";
+          ++n;
+          break;
+        }
+      }
+      if (want_checkpoints && std::chrono::duration<double>(now - last_checkpoint).count() >=
+                                  options.checkpoint_interval_s) {
+        write_checkpoint(n + 1, now, time_scheme);
+        last_checkpoint = Clock::now();  // the interval runs from the end of the write
+      }
     }
-    if (want_checkpoints && std::chrono::duration<double>(now - last_checkpoint).count() >=
-                                options.checkpoint_interval_s) {
-      write_checkpoint(n + 1, now);
-      last_checkpoint = Clock::now();  // the interval runs from the end of the write
-    }
+    if (watch.active() && result.status == RunStatus::successful && watched != j)
+      watch.check(particles_, t);  // the stage's end state
+    const std::vector<std::string> found = watch.messages();
+    result.run_warnings.insert(result.run_warnings.end(), found.begin(), found.end());
+    RunResult part;
+    time_scheme.report(part);
+    add_iterations(done_iterations, part.iterations);
   }
   const double seconds =
       seconds_before + std::chrono::duration<double>(Clock::now() - start).count();
-  if (watch.active() && result.status == RunStatus::successful && watched != n)
-    watch.check(particles_, t);  // the end state
-  result.run_warnings = watch.messages();
   result.warnings.insert(result.warnings.end(), result.run_warnings.begin(),
                          result.run_warnings.end());
-  time_scheme.report(result);
+  result.iterations = done_iterations;
   result.steps = n;
   result.end_time = t;
   result.solve_seconds = seconds;
   result.particle_steps_per_second =
       seconds > 0 ? static_cast<double>(n) * static_cast<double>(particles_.size()) / seconds : 0.0;
-  if (result.status == RunStatus::successful)
+  if (result.status == RunStatus::successful) {
     result.message = "completed " + std::to_string(n) + " steps to t = " + number(t) + " s";
+    if (stages > 1) result.message.append(" in ").append(std::to_string(stages)).append(" stages");
+  }
   report(n, t);
   return result;
 }

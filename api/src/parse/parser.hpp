@@ -102,6 +102,8 @@ void read_time(ParseContext& c, const json& j, const std::string& path);
 void read_local_damping(ParseContext& c, const json& j, const std::string& path);
 void read_initial_state(ParseContext& c, const json& j, const std::string& path);
 void read_output(ParseContext& c, const json& j, const std::string& path);
+/// `stages` (stages.cpp): after every other section (it reuses their readers).
+void read_stages(ParseContext& c, const json& j, const std::string& path);
 
 // ------------------------------------------------------ shared value readers
 /// {"min": [...], "max": [...]} inside the grid (when the grid is valid).
@@ -151,6 +153,7 @@ void flux_keys(std::vector<SpecObjectKeys>& out);
 void initial_state_keys(std::vector<SpecObjectKeys>& out);
 void time_keys(std::vector<SpecObjectKeys>& out);
 void output_keys(std::vector<SpecObjectKeys>& out);
+void stage_keys(std::vector<SpecObjectKeys>& out);
 /// The values of the spec's enumerations: output field names (from
 /// hmpm::field_table), traction faces, shape functions.
 Keys field_names();

@@ -309,6 +309,9 @@ struct ImplicitControl {
 
 struct TimeControl {
   double end = 1.0;  ///< s, required
+  /// s; the time the stage in force starts at (stage_problem sets it; 0 for
+  /// a job's first stage): the step rules count steps over end - start.
+  double start = 0.0;
   Scheme scheme = Scheme::explicit_scheme;
   std::optional<double> dt;  ///< s; absent: automatic
   /// quasi_static only: geometric growth instead of a fixed dt (dt absent).
@@ -353,6 +356,29 @@ struct OutputRequest {
   double profile_interval = 0.0;
 };
 
+/// A later stage of a staged job (Problem::stages): from the end of the
+/// stage before to `end`, with its changes. The state carries over; what a
+/// stage does not set stays as it was (the job's top level is the first
+/// stage). Lists it sets replace the whole list in force.
+struct Stage {
+  std::string name;  ///< for messages and progress
+  double end = 0.0;  ///< s, absolute; after the previous stage's end
+  /// Bodies whose particles join the run at the stage's start (a fill, a
+  /// construction layer), with their initial fields; a body some stage adds
+  /// is absent before it (and from the geostatic state).
+  std::vector<int> add_bodies;
+  /// Bodies whose particles leave the run at the stage's start (excavation).
+  std::vector<int> remove_bodies;
+  std::optional<std::vector<Boundary>> boundaries;
+  std::optional<std::vector<Traction>> tractions;
+  std::optional<std::vector<Flux>> fluxes;
+  std::optional<Vec3> gravity;
+  /// The stage's time control (scheme, dt, courant, implicit); its `end`
+  /// is ignored (the stage's own end rules).
+  std::optional<TimeControl> time;
+  std::optional<FieldOfTime> local_damping;
+};
+
 struct Problem {
   int dimension = 1;  ///< 1 (uniaxial strain), 2 (plane strain) or 3
   Grid grid;
@@ -372,6 +398,11 @@ struct Problem {
   /// empty = none. A value outside [0, 1) fails the run at that step.
   FieldOfTime local_damping;
   InitialState initial_state;
+  /// Later stages, in order (empty: one stage, the job itself, to
+  /// time.end). stage_problem (hmpm/run.hpp) gives the Problem in force
+  /// during each.
+  std::vector<Stage> stages;
+  std::string first_stage_name = "initial";  ///< the top level's stage name
 };
 
 }  // namespace hmpm

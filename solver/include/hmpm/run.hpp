@@ -88,6 +88,26 @@ std::vector<ProblemIssue> check_problem(const Problem& problem);
 /// earlier body where they overlap. The run's RunResult::warnings repeat them.
 std::vector<ProblemIssue> problem_warnings(const Problem& problem);
 
+/// Stages of a job: 1 + problem.stages.size() (the top level is stage 0).
+inline std::size_t stage_count(const Problem& problem) {
+  return 1 + problem.stages.size();
+}
+
+/// The Problem in force during stage k: the top level with the changes of
+/// stages 1..k applied (lists replaced, gravity, time control, damping),
+/// time.end the stage's end. Bodies stay the job's (all of them);
+/// stage_bodies says which have particles.
+Problem stage_problem(const Problem& problem, std::size_t k);
+
+/// Per body: whether its particles are in the run during stage k (a body
+/// some stage adds is absent before that stage; a removed one from its
+/// stage on).
+std::vector<bool> stage_bodies(const Problem& problem, std::size_t k);
+
+/// The job's ground at the start: the Problem without the bodies a stage
+/// adds (the geostatic state and its checks see this ground).
+Problem initial_ground(const Problem& problem);
+
 /// Number of particles the bodies generate (lays the bodies out).
 std::int64_t count_particles(const Problem& problem);
 

@@ -46,44 +46,54 @@ struct FluxLoad : FaceParticles {
   std::vector<Vec3> x0;  ///< empty unless source->rate_varies_in_space
 };
 
-/// The particles of `x0` (initial positions) that `source` selects, on its
-/// face. Initial length along the normal: the cell size over the body's
-/// particles per axis, recovered from the initial volume (particles of a
-/// body are not cubes when cells are not).
+/// A particle's initial position as a Vec3 (trailing components zero).
+template <int Dim>
+inline Vec3 initial_position(const ParticleState<Dim>& particles, std::size_t p) {
+  Vec3 x{0.0, 0.0, 0.0};
+  for (int a = 0; a < Dim; ++a) x[a] = particles.x0[p][a];
+  return x;
+}
+
+/// The particles in the run whose initial position `source` selects, on
+/// its face. volume0: each particle's initial volume. Initial length along
+/// the normal: the cell size over the body's particles per axis, recovered
+/// from the initial volume (particles of a body are not cubes when cells
+/// are not).
 template <int Dim, class Source>
 FaceParticles select_face_particles(const Problem& problem, const Source& source,
-                                    const std::vector<Vec3>& x0,
                                     const ParticleState<Dim>& particles,
+                                    const std::vector<double>& volume0,
                                     const GridState<Dim>& grid) {
   FaceParticles face;
   face.axis = source.axis;
   face.side = source.side;
   double cell_volume = 1.0;
   for (int a = 0; a < Dim; ++a) cell_volume *= grid.h[a];
-  for (std::size_t p = 0; p < x0.size(); ++p) {
-    if (!particle_selected(problem, source, x0[p])) continue;
+  for (std::size_t p = 0; p < particles.size(); ++p) {
+    if (!particle_selected(problem, source, initial_position(particles, p))) continue;
     face.particles.push_back(static_cast<std::int64_t>(p));
-    const double n_per_axis = std::round(std::pow(cell_volume / particles.volume[p], 1.0 / Dim));
+    const double n_per_axis = std::round(std::pow(cell_volume / volume0[p], 1.0 / Dim));
     face.length0.push_back(grid.h[face.axis] / std::max(n_per_axis, 1.0));
-    face.volume0.push_back(particles.volume[p]);
+    face.volume0.push_back(volume0[p]);
   }
   return face;
 }
 
-/// The loads of `problem` on the particles at their initial volumes.
+/// The loads of `problem` on the particles (volume0: their initial volumes).
 template <int Dim>
 std::vector<TractionLoad> compile_tractions(const Problem& problem,
                                             const ParticleState<Dim>& particles,
+                                            const std::vector<double>& volume0,
                                             const GridState<Dim>& grid) {
   std::vector<TractionLoad> tractions;
-  const std::vector<Vec3> x0 = initial_positions(problem);
   for (const Traction& t : problem.tractions) {
     TractionLoad load;
-    static_cast<FaceParticles&>(load) = select_face_particles(problem, t, x0, particles, grid);
+    static_cast<FaceParticles&>(load) = select_face_particles(problem, t, particles, volume0, grid);
     load.source = &t;
     if (std::any_of(t.traction_field.begin(), t.traction_field.end(),
                     [](const FieldOfSpaceTime& f) { return static_cast<bool>(f); }))
-      for (std::int64_t p : load.particles) load.x0.push_back(x0[static_cast<std::size_t>(p)]);
+      for (std::int64_t p : load.particles)
+        load.x0.push_back(initial_position(particles, static_cast<std::size_t>(p)));
     tractions.push_back(std::move(load));
   }
   return tractions;
@@ -92,16 +102,16 @@ std::vector<TractionLoad> compile_tractions(const Problem& problem,
 /// The fluxes of `problem` (saturated runs).
 template <int Dim>
 std::vector<FluxLoad> compile_fluxes(const Problem& problem, const ParticleState<Dim>& particles,
+                                     const std::vector<double>& volume0,
                                      const GridState<Dim>& grid) {
   std::vector<FluxLoad> fluxes;
-  if (problem.fluxes.empty()) return fluxes;
-  const std::vector<Vec3> x0 = initial_positions(problem);
   for (const Flux& f : problem.fluxes) {
     FluxLoad load;
-    static_cast<FaceParticles&>(load) = select_face_particles(problem, f, x0, particles, grid);
+    static_cast<FaceParticles&>(load) = select_face_particles(problem, f, particles, volume0, grid);
     load.source = &f;
     if (f.rate_varies_in_space)
-      for (std::int64_t p : load.particles) load.x0.push_back(x0[static_cast<std::size_t>(p)]);
+      for (std::int64_t p : load.particles)
+        load.x0.push_back(initial_position(particles, static_cast<std::size_t>(p)));
     fluxes.push_back(std::move(load));
   }
   return fluxes;

@@ -61,7 +61,7 @@ StableStep explicit_stable_step(const Problem& problem) {
   }
   s.limit = std::min(s.mechanical, s.hydraulic);
   s.chosen = problem.time.dt ? *problem.time.dt : problem.time.courant * s.limit;
-  s.steps = fixed_step_count(problem.time.end, s.chosen);
+  s.steps = fixed_step_count(problem.time.end - problem.time.start, s.chosen);
   return s;
 }
 

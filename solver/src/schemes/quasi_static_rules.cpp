@@ -29,7 +29,7 @@ namespace hmpm {
 
 StepGrowth quasi_static_growth(const Problem& problem) {
   if (problem.time.growth) return *problem.time.growth;
-  const double end = problem.time.end;
+  const double end = problem.time.end - problem.time.start;  // the stage's length
   StepGrowth g;
   g.max = end / 20.0;
   g.growth = 1.2;
@@ -62,7 +62,7 @@ namespace {
 
 StableStep quasi_static_stable_step(const Problem& problem) {
   StableStep s;
-  const double end = problem.time.end;
+  const double end = problem.time.end - problem.time.start;  // the stage's length
   // Unconditionally stable: no limit below the whole run.
   s.mechanical = s.hydraulic = s.limit = end;
   for (const Material& m : problem.materials) {

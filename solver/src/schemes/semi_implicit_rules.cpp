@@ -42,7 +42,7 @@ StableStep semi_implicit_stable_step(const Problem& problem) {
   }
   s.limit = s.mechanical;
   s.chosen = problem.time.dt ? *problem.time.dt : problem.time.courant * s.limit;
-  s.steps = fixed_step_count(problem.time.end, s.chosen);
+  s.steps = fixed_step_count(problem.time.end - problem.time.start, s.chosen);
   return s;
 }
 

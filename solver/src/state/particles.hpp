@@ -10,6 +10,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <vector>
@@ -55,29 +56,66 @@ struct ParticleState {
   /// As many arrays as the most any model with particles declares.
   std::vector<std::vector<double>> internal;
 
+  /// Staged jobs whose stages add or remove bodies: each particle's index
+  /// in the job's numbering (the contract's), as particles come and go;
+  /// empty otherwise.
+  std::vector<std::int64_t> id;
+
   std::size_t size() const { return x.size(); }
 
-  /// f(array) for every array above, in a fixed order (the checkpoint
-  /// writes and reads the whole particle state through it: a new array
-  /// belongs here too).
+  /// f(array of states[0], array of states[1], ...) for every array above,
+  /// the same array of each state together, in a fixed order (the
+  /// checkpoint writes and reads the whole particle state through it, the
+  /// stages move particles between states with it: a new array belongs
+  /// here too). The states must have as many internal arrays.
+  template <class F, class... States>
+  static void for_each_array_of(F&& f, States&... states) {
+    f(states.x...);
+    f(states.x0...);
+    f(states.v...);
+    f(states.mass...);
+    f(states.volume...);
+    f(states.stress...);
+    f(states.strain...);
+    f(states.material...);
+    f(states.cell...);
+    f(states.half_length...);
+    f(states.pressure...);
+    f(states.pressure_out...);
+    f(states.porosity...);
+    f(states.darcy...);
+    f(states.plastic_strain...);
+    f(states.id...);
+    const std::size_t internals = std::min({states.internal.size()...});
+    for (std::size_t k = 0; k < internals; ++k) f(states.internal[k]...);
+  }
+
   template <class F>
   void for_each_array(F&& f) {
-    f(x);
-    f(x0);
-    f(v);
-    f(mass);
-    f(volume);
-    f(stress);
-    f(strain);
-    f(material);
-    f(cell);
-    f(half_length);
-    f(pressure);
-    f(pressure_out);
-    f(porosity);
-    f(darcy);
-    f(plastic_strain);
-    for (std::vector<double>& k : internal) f(k);
+    for_each_array_of(f, *this);
+  }
+
+  /// Moves the particles p with leaves(p) to the end of `to` (in order),
+  /// closing the gaps here (the others keep their order). Arrays this
+  /// state does not use (empty) stay empty in both.
+  template <class Pred>
+  void move_to(ParticleState& to, Pred&& leaves) {
+    const std::size_t n = size();
+    std::vector<std::uint8_t> go(n);
+    for (std::size_t p = 0; p < n; ++p) go[p] = leaves(p) ? 1 : 0;
+    for_each_array_of(
+        [&](auto& from, auto& into) {
+          if (from.size() != n || n == 0) return;
+          std::size_t kept = 0;
+          for (std::size_t p = 0; p < n; ++p) {
+            if (go[p])
+              into.push_back(from[p]);
+            else
+              from[kept++] = from[p];
+          }
+          from.resize(kept);
+        },
+        *this, to);
   }
 
   void resize(std::size_t n, bool fluid, bool gimp, int state_variables = 0, bool plastic = false) {
@@ -109,6 +147,7 @@ struct ParticleState {
     if (!pressure.empty()) per += sizeof(double) * 3 + sizeof(Vec);
     per += sizeof(double) * internal.size();
     if (!plastic_strain.empty()) per += sizeof(double);
+    if (!id.empty()) per += sizeof(std::int64_t);
     return static_cast<std::int64_t>(n * per);
   }
 };

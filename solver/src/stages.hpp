@@ -1,0 +1,55 @@
+// stages.hpp — moving a Simulation from one stage of a staged job to the
+// next (internal; Problem::stages). The particle state carries over; the
+// Problem in force becomes the stage's (stage_problem), the particles of the
+// bodies it adds join the run and those of the bodies it removes leave it
+// (they wait, or stay, in dormant_), and everything compiled from the
+// Problem or the particles (constraints, tractions, fluxes, reactions,
+// gravity) is compiled again. The time loop (time_loop.hpp) makes a fresh
+// scheme for each stage. Runs between steps only; allocates.
+#pragma once
+
+#include <algorithm>
+#include <cstdint>
+#include <vector>
+
+#include "boundary/constraints.hpp"
+#include "boundary/tractions.hpp"
+#include "simulation.hpp"
+
+namespace hmpm {
+
+template <int Dim, class Shape>
+void Simulation<Dim, Shape>::move_stage_particles(std::size_t k) {
+  const std::vector<bool> in = stage_bodies(job_, k);
+  auto in_run = [&](std::int64_t id) {
+    const auto after = std::upper_bound(body_begin_.begin(), body_begin_.end(), id);
+    return in[static_cast<std::size_t>(after - body_begin_.begin() - 1)];
+  };
+  particles_.move_to(dormant_, [&](std::size_t p) { return !in_run(particles_.id[p]); });
+  dormant_.move_to(particles_, [&](std::size_t p) { return in_run(dormant_.id[p]); });
+  slot_.assign(static_cast<std::size_t>(job_particles_), -1);
+  for (std::size_t p = 0; p < particles_.size(); ++p)
+    slot_[static_cast<std::size_t>(particles_.id[p])] = static_cast<std::int64_t>(p);
+}
+
+template <int Dim, class Shape>
+void Simulation<Dim, Shape>::enter_stage(std::size_t k) {
+  // Stage by stage (a resumed run replays the moves of the stages it skips),
+  // so the particles end in the order an uninterrupted run gives them.
+  if (!body_begin_.empty())
+    for (std::size_t j = stage_ + 1; j <= k; ++j) move_stage_particles(j);
+  stage_ = k;
+  problem_ = stage_problem(job_, k);
+  for (int a = 0; a < Dim; ++a) gravity_[a] = problem_.gravity[a];
+  // The loads are laid on the particles' initial faces: their initial
+  // volumes, from the constant mass and the material's mixture density.
+  std::vector<double> volume0(particles_.size());
+  for (std::size_t p = 0; p < particles_.size(); ++p)
+    volume0[p] = particles_.mass[p] / constants_[particles_.material[p]].mixture_density;
+  constraints_ = compile_constraints<Dim>(problem_, grid_, grid_max_, fluid_);
+  tractions_ = compile_tractions<Dim>(problem_, particles_, volume0, grid_);
+  if (fluid_) fluxes_ = compile_fluxes<Dim>(problem_, particles_, volume0, grid_);
+  if (problem_.output.reactions_interval > 0) setup_reactions();
+}
+
+}  // namespace hmpm
