@@ -278,7 +278,8 @@ RunResult Simulation<Dim, Shape>::run(const RunOptions& options) {
   // "stage 'excavation' (2 of 3), " in messages of staged jobs.
   auto stage_text = [&]() -> std::string {
     if (stages == 1) return "";
-    const std::string& name = stage_ == 0 ? job_.first_stage_name : job_.stages[stage_ - 1].name;
+    std::string name = stage_ == 0 ? job_.first_stage_name : job_.stages[stage_ - 1].name;
+    if (name.empty()) name = std::to_string(stage_ + 1);
     return "stage '" + name + "' (" + std::to_string(stage_ + 1) + " of " + std::to_string(stages) +
            "), ";
   };

@@ -9,6 +9,7 @@
 #include <atomic>
 #include <chrono>
 #include <cstdio>
+#include <cstring>
 #include <limits>
 #include <stdexcept>
 #include <string>
@@ -132,14 +133,27 @@ class Resume : public ::testing::TestWithParam<hmpm::Scheme> {};
 // Bit-identical: EXPECT_EQ on doubles and whole arrays, no tolerance. A
 // missing piece of state (a series sample, the step plan, an initial guess,
 // a plastic internal variable) changes later steps by round-off at least.
-TEST_P(Resume, FromAMidRunCheckpointGivesTheUninterruptedResultsBitForBit) {
-  const hmpm::Problem p = block(GetParam());
+/// Bit for bit, NaN equal to NaN.
+bool same_bits(const std::vector<std::vector<double>>& a,
+               const std::vector<std::vector<double>>& b) {
+  if (a.size() != b.size()) return false;
+  for (std::size_t i = 0; i < a.size(); ++i)
+    if (a[i].size() != b[i].size() ||
+        std::memcmp(a[i].data(), b[i].data(), a[i].size() * sizeof(double)) != 0)
+      return false;
+  return true;
+}
+
+// Interrupted after `fraction` of its steps and resumed, `p` ends as run
+// whole.
+void expect_resume_as_whole(const hmpm::Problem& p, const char* label, double fraction = 0.5) {
   const Outputs whole = run(p, -1, nullptr);
   ASSERT_EQ(whole.result.status, hmpm::RunStatus::successful) << whole.result.message;
   const std::int64_t steps = whole.result.steps;
   ASSERT_GE(steps, 6) << "too few steps to interrupt";
   ASSERT_GE(whole.snapshots.size(), 3u);
-  const std::int64_t k = steps / 2 + 1;  // some snapshots before, some after
+  // Some snapshots before, some after.
+  const auto k = static_cast<std::int64_t>(fraction * static_cast<double>(steps)) + 1;
   const Outputs first = run(p, k, nullptr);
   ASSERT_FALSE(first.checkpoint.empty());
   EXPECT_EQ(first.checkpoints, steps);
@@ -152,8 +166,7 @@ TEST_P(Resume, FromAMidRunCheckpointGivesTheUninterruptedResultsBitForBit) {
   std::printf(
       "%s: %lld steps, checkpoint at step %lld: %zu bytes, %.1f bytes per particle, "
       "inspected in %.2g s\n",
-      hmpm::scheme_name(GetParam()), static_cast<long long>(steps), static_cast<long long>(k),
-      first.checkpoint.size(),
+      label, static_cast<long long>(steps), static_cast<long long>(k), first.checkpoint.size(),
       static_cast<double>(first.checkpoint.size()) / static_cast<double>(whole.result.particles),
       inspect_s);
 
@@ -171,7 +184,7 @@ TEST_P(Resume, FromAMidRunCheckpointGivesTheUninterruptedResultsBitForBit) {
     expect_same_snapshot(resumed.snapshots[i], whole.snapshots[info.snapshot_times.size() + i]);
   const hmpm::Series &a = resumed.result.series, &b = whole.result.series;
   EXPECT_EQ(a.time, b.time);
-  EXPECT_EQ(a.values, b.values);
+  EXPECT_TRUE(same_bits(a.values, b.values));  // NaN (a particle out of the run) included
   EXPECT_EQ(a.particles, b.particles);
   ASSERT_FALSE(whole.result.reactions.time.empty());
   EXPECT_EQ(resumed.result.reactions.time, whole.result.reactions.time);
@@ -190,6 +203,44 @@ TEST_P(Resume, FromAMidRunCheckpointGivesTheUninterruptedResultsBitForBit) {
   EXPECT_EQ(ia.cutbacks, ib.cutbacks);
   EXPECT_EQ(ia.max_nonlinear, ib.max_nonlinear);
   EXPECT_EQ(ia.worst_residuals, ib.worst_residuals);
+}
+
+TEST_P(Resume, FromAMidRunCheckpointGivesTheUninterruptedResultsBitForBit) {
+  expect_resume_as_whole(block(GetParam()), hmpm::scheme_name(GetParam()));
+}
+
+// A staged job: the explicit block, then a fill added above it with a
+// smaller Courant factor (a fresh scheme, another dt), then the fill
+// removed again. (The semi-implicit scheme cannot take this collapsing
+// block with free sides, staged or not: a particle volume turns negative at
+// t = 0.013 s with linear shape functions.) Interrupted in the second stage and in the third (after
+// both moves of particles), it resumes as run whole: the particles in the order of the
+// uninterrupted run, the stage's scheme state, the iterations of the stages before.
+TEST(Resume, AcrossStagesThatAddAndRemoveBodies) {
+  hmpm::Problem p = block(hmpm::Scheme::explicit_scheme);
+  p.time.end = 0.01;
+  hmpm::Body fill = p.bodies[0];
+  fill.box.min = {0.0, 1.0, 0};
+  fill.box.max = {1.0, 1.2, 0};
+  fill.initial = hmpm::InitialFields{};
+  p.bodies.push_back(fill);
+  hmpm::Stage add;
+  add.name = "fill";
+  add.end = 0.02;
+  add.add_bodies = {1};
+  hmpm::TimeControl smaller;
+  smaller.courant = 0.35;
+  add.time = smaller;
+  hmpm::Stage dig;
+  dig.name = "dig";
+  dig.end = 0.03;
+  dig.remove_bodies = {1};
+  dig.time = hmpm::TimeControl{};
+  p.stages = {add, dig};
+  p.output.series_particles.push_back(hmpm::count_particles(p) - 1);  // in the fill
+  ASSERT_TRUE(hmpm::check_problem(p).empty());
+  expect_resume_as_whole(p, "staged, stage 2", 0.5);
+  expect_resume_as_whole(p, "staged, stage 3", 0.85);
 }
 
 INSTANTIATE_TEST_SUITE_P(Schemes, Resume,
