@@ -95,6 +95,8 @@ class Simulation {
   void enter_stage(std::size_t k);
   /// The particles of the bodies in force at stage k, and slot_ to match.
   void move_stage_particles(std::size_t k);
+  /// Stage::reset_displacement: x0 = x, strain zero.
+  void reset_displacement();
   void balance_initial_pressure_state();
 
   // ------------------------------------------------------------ phases (phases/)

@@ -33,13 +33,31 @@ void Simulation<Dim, Shape>::move_stage_particles(std::size_t k) {
 }
 
 template <int Dim, class Shape>
+void Simulation<Dim, Shape>::reset_displacement() {
+  for (std::size_t p = 0; p < particles_.size(); ++p) {
+    particles_.x0[p] = particles_.x[p];
+    particles_.strain[p].setZero();
+  }
+}
+
+template <int Dim, class Shape>
 void Simulation<Dim, Shape>::enter_stage(std::size_t k) {
   // Stage by stage (a resumed run replays the moves of the stages it skips),
   // so the particles end in the order an uninterrupted run gives them.
   if (!body_begin_.empty())
     for (std::size_t j = stage_ + 1; j <= k; ++j) move_stage_particles(j);
+  // Stage by stage too: a resumed run reads the particle state after this.
+  for (std::size_t j = stage_ + 1; j <= k; ++j)
+    if (job_.stages[j - 1].reset_displacement) reset_displacement();
+  // From the quasi-static scheme (no inertia: its velocities are the
+  // step's mean rates, dx / dt) to an inertial one, the ground starts at
+  // rest: a gravity-loading stage of one long step would otherwise hand its
+  // whole settlement over as a velocity.
+  const bool was_static = problem_.time.scheme == Scheme::quasi_static;
   stage_ = k;
   problem_ = stage_problem(job_, k);
+  if (was_static && problem_.time.scheme != Scheme::quasi_static)
+    for (auto& v : particles_.v) v.setZero();
   for (int a = 0; a < Dim; ++a) gravity_[a] = problem_.gravity[a];
   // The loads are laid on the particles' initial faces: their initial
   // volumes, from the constant mass and the material's mixture density.

@@ -23,8 +23,8 @@ namespace hmpm::api::parse {
 namespace {
 
 constexpr std::string_view stage_allowed[] = {
-    "name",      "end",    "add_bodies", "remove_bodies", "boundaries",
-    "tractions", "fluxes", "gravity",    "time",          "local_damping"};
+    "name",   "end",     "add_bodies", "remove_bodies", "boundaries",        "tractions",
+    "fluxes", "gravity", "time",       "local_damping", "reset_displacement"};
 constexpr std::string_view stage_required[] = {"end"};
 
 /// Reads into `target` what `read` puts into the top level's `slot`,
@@ -56,6 +56,9 @@ void read_stage(ParseContext& c, const json& j, const std::string& path, Stage& 
     s.add_bodies = read_body_list(c, j["add_bodies"], path + "/add_bodies");
   if (j.contains("remove_bodies"))
     s.remove_bodies = read_body_list(c, j["remove_bodies"], path + "/remove_bodies");
+  if (j.contains("reset_displacement"))
+    if (auto b = c.r.boolean(j["reset_displacement"], path + "/reset_displacement"))
+      s.reset_displacement = *b;
   if (j.contains("gravity"))
     if (auto g = c.r.vector(j["gravity"], path + "/gravity", c.dim)) s.gravity = *g;
   if (j.contains("boundaries"))

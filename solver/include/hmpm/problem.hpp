@@ -377,6 +377,11 @@ struct Stage {
   /// is ignored (the stage's own end rules).
   std::optional<TimeControl> time;
   std::optional<FieldOfTime> local_damping;
+  /// At the stage's start, the particles' current positions become their
+  /// initial ones (displacement and strain start again from zero; later
+  /// selections by initial position use them): after a gravity-loading
+  /// stage.
+  bool reset_displacement = false;
 };
 
 struct Problem {
