@@ -63,6 +63,16 @@ inline hmpm::Boundary fixed_pressure(const hmpm::NodeSelection& nodes, double va
   return b;
 }
 
+/// A dry linear elastic material.
+inline hmpm::Material elastic(double rho, double e, double nu) {
+  hmpm::Material m;
+  m.name = "soil";
+  m.density = rho;
+  m.youngs_modulus = e;
+  m.poisson_ratio = nu;
+  return m;
+}
+
 /// A linear elastic saturated material (incompressible grains, water of
 /// density 1000 kg/m^3 and bulk modulus kw).
 inline hmpm::Material saturated_elastic(double rho_s, double e, double nu, double porosity,

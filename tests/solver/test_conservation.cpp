@@ -14,14 +14,7 @@
 
 namespace {
 
-hmpm::Material elastic(double rho, double E, double nu) {
-  hmpm::Material m;
-  m.name = "soil";
-  m.density = rho;
-  m.youngs_modulus = E;
-  m.poisson_ratio = nu;
-  return m;
-}
+using problems::elastic;
 
 // A free 2D block spinning and shearing in the middle of a large grid: no
 // boundary, no gravity. Internal forces sum to zero at the nodes (the

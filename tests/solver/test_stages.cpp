@@ -195,15 +195,6 @@ TEST(Stages, ChecksSayWhereEachStageIsWrong) {
 // the displacements reset. For level layers it must give the geostatic
 // closed form; for a slope it must leave ground at rest.
 
-hmpm::Material dry(double rho, double e, double nu) {
-  hmpm::Material m;
-  m.name = "ground";
-  m.density = rho;
-  m.youngs_modulus = e;
-  m.poisson_ratio = nu;
-  return m;
-}
-
 // Two saturated layers, water table at the surface (p = 0 there, the
 // hydrostatic pressure as the initial field), loaded by gravity in one
 // drained quasi-static step. Closed form (verification §6, as the geostatic
@@ -293,7 +284,7 @@ TEST(GravityLoading, AShapedSlopeIsLeftAtRest) {
     p.dimension = 2;
     p.grid.max = {12.0, 6.0, 0};
     p.grid.cells = {12 * per_m, 6 * per_m, 1};
-    p.materials.push_back(dry(2000, 2e7, 0.3));
+    p.materials.push_back(problems::elastic(2000, 2e7, 0.3));
     hmpm::Body slope;
     slope.polygon = hmpm::Polygon{{{0, 0}, {12, 0}, {12, 2}, {8, 2}, {4, 5}, {0, 5}}};
     slope.particles_per_cell = 2;
