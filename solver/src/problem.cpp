@@ -617,6 +617,7 @@ namespace {
 void check_stages(const Problem& problem, std::vector<ProblemIssue>& issues) {
   if (problem.stages.empty()) return;
   std::vector<std::string> top;
+  top.reserve(issues.size());
   for (const ProblemIssue& i : issues) top.push_back(i.where.text() + ": " + i.message);
   double previous = problem.time.end;
   for (std::size_t i = 0; i < problem.stages.size(); ++i) {
