@@ -589,5 +589,58 @@ TEST(ParseJob, ProfilesPickTheParticlesNearestToTheirPoints) {
       << outside.errors[0].message;
 }
 
+// Stages (docs/job-spec.md, stages[i]): each entry's lists are read by the
+// top level's readers into the stage, leaving the top level's as they were;
+// `time` replaces the whole time control (defaults for what it omits);
+// mistakes are reported at the stage's own paths.
+TEST(ParseJob, StagesAreReadIntoTheirStageAndCheckedAtTheirPaths) {
+  json spec = json::parse(read_text(source_path("examples/staged-excavation.json")));
+  const ParsedJob job = parse_valid(spec.dump());
+  const Problem& p = job.problem;
+  ASSERT_EQ(p.stages.size(), 1u);
+  const Stage& s = p.stages[0];
+  EXPECT_EQ(s.name, "excavation");
+  EXPECT_DOUBLE_EQ(s.end, 1728001.0);
+  EXPECT_EQ(s.remove_bodies, std::vector<int>{0});
+  EXPECT_TRUE(s.add_bodies.empty());
+  EXPECT_EQ(p.boundaries.size(), 4u);  // the top level's list is untouched
+  ASSERT_TRUE(s.boundaries.has_value());
+  EXPECT_EQ(s.boundaries->size(), 6u);
+  EXPECT_FALSE(s.tractions.has_value());  // not given: the list in force stays
+  ASSERT_TRUE(s.time.has_value());
+  EXPECT_EQ(s.time->scheme, Scheme::quasi_static);
+  ASSERT_TRUE(s.time->growth.has_value());
+  EXPECT_DOUBLE_EQ(s.time->growth->initial, 100.0);
+  EXPECT_DOUBLE_EQ(s.time->courant, 0.5);  // a default, not the stage before's
+  EXPECT_FALSE(s.reset_displacement);
+  // The estimate counts the steps of both stages (1 + the growing plan).
+  EXPECT_GT(job.cost.steps, 30);
+
+  spec["stages"][0]["remove_bodies"] = json::array({0, 9});
+  spec["stages"][0]["time"]["end"] = 5;
+  spec["stages"][0]["boundaries"][3]["nodes"]["bx"] = 1;
+  spec["stages"][0]["reset_displacement"] = "yes";
+  spec["stages"].push_back(json{{"end", 10.0}, {"gravity", json::array({0.0})}});
+  spec["stages"].push_back(json{{"ends", 10.0}});
+  const ParseResult r = parse_job(spec.dump());
+  std::vector<std::string> paths;
+  for (const auto& e : r.errors) paths.push_back(e.path);
+  for (const char* want :
+       {"/stages/0/time/end", "/stages/0/boundaries/3/nodes/bx", "/stages/0/reset_displacement",
+        "/stages/1/gravity", "/stages/2/ends", "/stages/2/end"}) {
+    EXPECT_NE(std::find(paths.begin(), paths.end(), want), paths.end()) << want;
+  }
+  // The solver's checks once the reading is clean: a body that does not
+  // exist, an end before the stage before's.
+  json order = json::parse(read_text(source_path("examples/staged-excavation.json")));
+  order["stages"][0]["remove_bodies"] = json::array({0, 9});
+  order["stages"].push_back(json{{"end", 10.0}});
+  const ParseResult r2 = parse_job(order.dump());
+  paths.clear();
+  for (const auto& e : r2.errors) paths.push_back(e.path);
+  for (const char* want : {"/stages/0/remove_bodies/1", "/stages/1/end"})
+    EXPECT_NE(std::find(paths.begin(), paths.end(), want), paths.end()) << want;
+}
+
 }  // namespace
 }  // namespace hmpm::api
