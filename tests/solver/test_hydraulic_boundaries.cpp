@@ -190,24 +190,36 @@ hmpm::RunResult seepage_column(const Column& col, double pb) {
 // 1) up the column, both exact at steady state (round-off, 1e-6; run to
 // c t / H^2 = 8 as the inflow column: the slowest mode is the same).
 TEST(HydraulicBoundaries, SeepageFaceOfAnArtesianColumnDrainsToZeroWithTheExactOutflow) {
-  for (int dim : {1, 2}) {
-    Column col;
-    col.dim = dim;
-    col.gravity = 9.81;
-    const double pb = 1.5 * gamma_w * col.L;
-    const hmpm::RunResult r = seepage_column(col, pb);
-    ASSERT_EQ(r.status, hmpm::RunStatus::successful) << r.message;
-    const hmpm::Series& s = r.series;
-    const std::size_t last = s.time.size() - 1, np = s.particles.size();
-    const double outflow = col.k * (pb / (gamma_w * col.L) - 1.0);
-    for (std::size_t i = 0; i < np; ++i) {
-      const double x = s.initial_positions[i][0];
-      EXPECT_NEAR(s.values[0][last * np + i], pb * (1 - x / col.L), 1e-6 * pb)
-          << "dim " << dim << " particle " << i;
-      EXPECT_NEAR(s.values[1][(last * np + i) * dim], outflow, 1e-6 * outflow)
-          << "dim " << dim << " particle " << i;
+  for (hmpm::Scheme scheme : {hmpm::Scheme::explicit_scheme, hmpm::Scheme::semi_implicit})
+    for (int dim : {1, 2}) {
+      SCOPED_TRACE(name(scheme));
+      Column col;
+      col.dim = dim;
+      col.gravity = 9.81;
+      col.scheme = scheme;
+      const double pb = 1.5 * gamma_w * col.L;
+      const hmpm::RunResult r = seepage_column(col, pb);
+      ASSERT_EQ(r.status, hmpm::RunStatus::successful) << r.message;
+      const hmpm::Series& s = r.series;
+      const std::size_t last = s.time.size() - 1, np = s.particles.size();
+      const double outflow = col.k * (pb / (gamma_w * col.L) - 1.0);
+      // The semi-implicit scheme's own steady error in a fixed skeleton
+      // (the steady inflow test above): its tolerances there, 1e-4 and 6e-2.
+      const bool semi = scheme == hmpm::Scheme::semi_implicit;
+      const double tol_p = semi ? 1e-4 : 1e-6, tol_w = semi ? 6e-2 : 1e-6;
+      double worst_p = 0, worst_w = 0;
+      for (std::size_t i = 0; i < np; ++i) {
+        const double x = s.initial_positions[i][0];
+        const double pe = s.values[0][last * np + i] - pb * (1 - x / col.L);
+        const double we = s.values[1][(last * np + i) * dim] - outflow;
+        worst_p = std::max(worst_p, std::abs(pe) / pb);
+        worst_w = std::max(worst_w, std::abs(we) / outflow);
+        EXPECT_LT(std::abs(pe), tol_p * pb) << "dim " << dim << " particle " << i;
+        EXPECT_LT(std::abs(we), tol_w * outflow) << "dim " << dim << " particle " << i;
+      }
+      std::printf("artesian seepage column, %s %dD: p %.2e of p_b, outflow %.2e off\n",
+                  name(scheme), dim, worst_p, worst_w);
     }
-  }
 }
 
 // Below hydrostatic (§11): p_b < gamma_w H. Starting from p = 0 everywhere
@@ -215,29 +227,43 @@ TEST(HydraulicBoundaries, SeepageFaceOfAnArtesianColumnDrainsToZeroWithTheExactO
 // the face takes no water in: the column goes to rest at the hydrostatic
 // p = p_b - gamma_w x, negative at the top, with no flow (round-off).
 TEST(HydraulicBoundaries, SeepageFaceBelowHydrostaticTakesNoWaterIn) {
-  Column col;
-  col.gravity = 9.81;
-  const double pb = 0.6 * gamma_w * col.L;
-  const double end = 8.0 * col.L * col.L / col.c();
-  const hmpm::RunResult r = seepage_column(col, pb);
-  ASSERT_EQ(r.status, hmpm::RunStatus::successful) << r.message;
-  const hmpm::Series& s = r.series;
-  const std::size_t last = s.time.size() - 1, np = s.particles.size();
-  for (std::size_t i = 0; i < np; ++i) {
-    const double x = s.initial_positions[i][0];
-    EXPECT_NEAR(s.values[0][last * np + i], pb - gamma_w * x, 1e-6 * pb) << "particle " << i;
-    EXPECT_NEAR(s.values[1][last * np + i], 0.0, 1e-6 * col.k) << "particle " << i;
+  for (hmpm::Scheme scheme : {hmpm::Scheme::explicit_scheme, hmpm::Scheme::semi_implicit}) {
+    SCOPED_TRACE(name(scheme));
+    Column col;
+    col.gravity = 9.81;
+    col.scheme = scheme;
+    const double pb = 0.6 * gamma_w * col.L;
+    const double end = 8.0 * col.L * col.L / col.c();
+    const hmpm::RunResult r = seepage_column(col, pb);
+    ASSERT_EQ(r.status, hmpm::RunStatus::successful) << r.message;
+    const hmpm::Series& s = r.series;
+    const std::size_t last = s.time.size() - 1, np = s.particles.size();
+    // The semi-implicit scheme's steady error as above, the flux against
+    // 0.4 k (what a face held at p = 0 would draw in).
+    const bool semi = scheme == hmpm::Scheme::semi_implicit;
+    const double tol_p = semi ? 1e-4 : 1e-6, tol_w = semi ? 6e-2 * 0.4 : 1e-6;
+    double worst_p = 0, worst_w = 0;
+    for (std::size_t i = 0; i < np; ++i) {
+      const double x = s.initial_positions[i][0];
+      const double pe = s.values[0][last * np + i] - (pb - gamma_w * x);
+      worst_p = std::max(worst_p, std::abs(pe) / pb);
+      worst_w = std::max(worst_w, std::abs(s.values[1][last * np + i]) / col.k);
+      EXPECT_LT(std::abs(pe), tol_p * pb) << "particle " << i;
+      EXPECT_LT(std::abs(s.values[1][last * np + i]), tol_w * col.k) << "particle " << i;
+    }
+    std::printf("seepage face below hydrostatic, %s: p %.2e of p_b, |w| %.2e of k\n", name(scheme),
+                worst_p, worst_w);
+    // The same column with p = 0 prescribed at the top instead: water enters
+    // there (the test above can tell the difference).
+    hmpm::Problem held = fixed_column(col, end);
+    held.boundaries.push_back(problems::fixed_pressure(problems::plane(held, 0, 0.0), pb));
+    held.boundaries.push_back(problems::fixed_pressure(problems::plane(held, 0, col.L), 0.0));
+    held.output.series_interval = end;
+    const hmpm::RunResult rh = hmpm::run(held);
+    ASSERT_EQ(rh.status, hmpm::RunStatus::successful) << rh.message;
+    EXPECT_LT(rh.series.values[1][(rh.series.time.size() - 1) * np], -0.1 * col.k)
+        << "a face held at p = 0 should draw water down the column";
   }
-  // The same column with p = 0 prescribed at the top instead: water enters
-  // there (the test above can tell the difference).
-  hmpm::Problem held = fixed_column(col, end);
-  held.boundaries.push_back(problems::fixed_pressure(problems::plane(held, 0, 0.0), pb));
-  held.boundaries.push_back(problems::fixed_pressure(problems::plane(held, 0, col.L), 0.0));
-  held.output.series_interval = end;
-  const hmpm::RunResult rh = hmpm::run(held);
-  ASSERT_EQ(rh.status, hmpm::RunStatus::successful) << rh.message;
-  EXPECT_LT(rh.series.values[1][(rh.series.time.size() - 1) * np], -0.1 * col.k)
-      << "a face held at p = 0 should draw water down the column";
 }
 
 // A reservoir against a sloping face (issue 17): a 2D trapezoid of soil
@@ -298,7 +324,8 @@ TEST(HydraulicBoundaries, ChecksNameTheEntryAndWhatToChange) {
   face.seepage = true;
   face.pore_pressure = problems::constant(0.0);
   p.boundaries.push_back(face);
-  p.time.scheme = hmpm::Scheme::semi_implicit;
+  p.time.scheme = hmpm::Scheme::quasi_static;
+  p.time.dt = 0.001;
   const auto issues = hmpm::check_problem(p);
   std::vector<std::string> at;
   at.reserve(issues.size());
@@ -307,7 +334,7 @@ TEST(HydraulicBoundaries, ChecksNameTheEntryAndWhatToChange) {
   EXPECT_NE(at[0].find("boundaries/1/seepage: cannot share an entry with pore_pressure"),
             std::string::npos)
       << at[0];
-  EXPECT_NE(at[1].find("explicit scheme only"), std::string::npos) << at[1];
+  EXPECT_NE(at[1].find("explicit and semi_implicit schemes only"), std::string::npos) << at[1];
 
   hmpm::Problem dry = problems::column(1, 0, 1.0, 10, 1);
   hmpm::Material m;

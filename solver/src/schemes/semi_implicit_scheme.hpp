@@ -78,6 +78,8 @@ class SemiImplicitScheme final : public TimeScheme {
     last_dp_.assign(n, 0.0);
     for (const PressureConstraint& bc : sim_.constraints_.pressure)
       for (std::int64_t i : bc.nodes) prescribed_[static_cast<std::size_t>(i)] = 1;
+    for (const SeepageFace& face : sim_.constraints_.seepage)
+      seepage_.insert(seepage_.end(), face.nodes.begin(), face.nodes.end());
     for (int o = 0; o < Box::size; ++o)
       node_offset_[static_cast<std::size_t>(o)] = Box::node_offset(o, sim_.grid_.stride);
   }
@@ -143,6 +145,7 @@ class SemiImplicitScheme final : public TimeScheme {
   /// again (the step's re-map proper comes later).
   bool solve_pressure_increment(double t, double dt) {
     auto& grid = sim_.grid_;
+    dt_ = dt;
     sim_.for_particles(nodal::bit(nodal::remap), [&](const Out& out, std::size_t b, std::size_t e) {
       sim_.map_predicted_velocity(out, b, e, dt);
     });
@@ -164,6 +167,41 @@ class SemiImplicitScheme final : public TimeScheme {
     assemble_laplacian(dt);
     std::fill(grid.dp.begin(), grid.dp.end(), 0.0);
     apply_pressure_increment_constraints(sim_.constraints_, grid, t + dt);
+    // Seepage faces: an active set. Every face node starts free (no water
+    // enters a free node); a node the solve would raise above p = 0 is held
+    // there (dp = -p: the water that would raise it leaves) and the system
+    // solved again, until no free face node rises above zero: per step the
+    // complementarity p <= 0, outflow >= 0 of the explicit scheme's rule.
+    bool ok = solve_once();
+    for (std::size_t round = 0; ok && round < seepage_.size(); ++round) {
+      bool changed = false;
+      for (std::int64_t i : seepage_) {
+        const auto u = static_cast<std::size_t>(i);
+        if (prescribed_[u] || grid.pressure[u] + grid.dp[u] <= 0.0) continue;
+        prescribed_[u] = 1;
+        grid.dp[u] = -grid.pressure[u];
+        changed = true;
+      }
+      if (!changed) break;
+      ok = solve_once();
+    }
+    for (std::int64_t i : seepage_) prescribed_[static_cast<std::size_t>(i)] = 0;
+    // The coupling boxes and activity flags, cleared for the next step.
+    for (std::size_t u = 0; u < active_.size(); ++u) {
+      if (!active_[u]) continue;
+      active_[u] = 0;
+      std::fill(box_.data() + u * Box::size, box_.data() + (u + 1) * Box::size, 0.0);
+    }
+    return ok;
+  }
+
+  /// Numbers the unknowns (active free nodes), assembles the system from
+  /// the coupling boxes (kept: a seepage face may ask for another solve)
+  /// and solves it into grid dp; false (a failure of the run) when the
+  /// solve fails.
+  bool solve_once() {
+    auto& grid = sim_.grid_;
+    const double dt = dt_;
     // Unknowns: active, free nodes with a positive diagonal, in node order.
     const std::int64_t count = grid.count;
     int n = 0;
@@ -179,7 +217,6 @@ class SemiImplicitScheme final : public TimeScheme {
     for (std::int64_t i = 0; i < count; ++i) {
       const auto u = static_cast<std::size_t>(i);
       if (!active_[u]) continue;
-      active_[u] = 0;
       double* const row = box_.data() + u * Box::size;
       const int c = unknown_[u];
       if (c >= 0) {
@@ -199,7 +236,6 @@ class SemiImplicitScheme final : public TimeScheme {
           rhs_[static_cast<std::size_t>(cj)] -= v * grid.dp[u];
       }
       if (c >= 0) system_.end_column();
-      std::fill(row, row + Box::size, 0.0);
     }
     if (n == 0) return true;
     for (int c = 0; c < n; ++c)
@@ -385,6 +421,8 @@ class SemiImplicitScheme final : public TimeScheme {
   std::vector<int> unknown_;
   std::vector<std::int64_t> node_of_;
   std::vector<double> rhs_, x_, last_dp_;
+  std::vector<std::int64_t> seepage_;  ///< seepage face nodes (an active set each step)
+  double dt_ = 0.0;                    ///< the step's length, for solve_once
   std::array<std::int64_t, Box::size> node_offset_{};
   struct Band {
     std::int64_t first = 0;            ///< its lowest node
