@@ -430,7 +430,7 @@ void check_selection_polygon(const Problem& problem, const Polygon& polygon, con
 }
 
 // Fluxes and seepage faces: they act on the pore water, so they need a
-// saturated material; a seepage face is the explicit and semi-implicit schemes' for now.
+// saturated material (every scheme has both).
 void check_hydraulic_boundaries(const Problem& problem, std::vector<ProblemIssue>& issues) {
   const bool saturated = std::any_of(problem.materials.begin(), problem.materials.end(),
                                      [](const Material& m) { return m.hydraulic.has_value(); });
@@ -455,12 +455,6 @@ void check_hydraulic_boundaries(const Problem& problem, std::vector<ProblemIssue
                         "cannot share an entry with pore_pressure: a seepage face decides its "
                         "own pressure (p = 0 while water leaves); give the prescribed "
                         "pressure its own boundary entry (it wins where both meet)"});
-    if (problem.time.scheme == Scheme::quasi_static)
-      issues.push_back({w, std::string("is available with the explicit and semi_implicit "
-                                       "schemes only in this release; this job asks for ") +
-                               scheme_name(problem.time.scheme) +
-                               ": use time.scheme \"semi_implicit\" or \"explicit\", or hold "
-                               "the face at p = 0 with pore_pressure (which also lets water in)"});
   }
 }
 

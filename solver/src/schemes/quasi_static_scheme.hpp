@@ -98,6 +98,9 @@ class QuasiStaticScheme final : public TimeScheme {
     for (const MaterialConstants& mc : sim_.constants_)
       e_ref_ = std::max(e_ref_, mc.constrained_modulus);
     if (!(e_ref_ > 0)) e_ref_ = 1.0;
+    for (const SeepageFace& face : sim_.constraints_.seepage)
+      seepage_.insert(seepage_.end(), face.nodes.begin(), face.nodes.end());
+    held_.assign(static_cast<std::size_t>(sim_.grid_.count), 0);
   }
 
   StableStep stable_step(const Problem& problem) const override {
@@ -241,6 +244,8 @@ class QuasiStaticScheme final : public TimeScheme {
     pfixed_.assign(nodes, 0);
     for (const PressureConstraint& bc : sim_.constraints_.pressure)
       for (std::int64_t i : bc.nodes) pfixed_[static_cast<std::size_t>(i)] = 1;
+    for (std::int64_t i : seepage_)
+      if (held_[static_cast<std::size_t>(i)]) pfixed_[static_cast<std::size_t>(i)] = 1;
     for (std::size_t i = 0; i < nodes; ++i) {
       if (!(weight_[i] > tiny)) continue;
       for (int a = 0; a < Dim; ++a) {
@@ -350,6 +355,8 @@ class QuasiStaticScheme final : public TimeScheme {
     for (std::size_t i = 0; i < nodes; ++i) p_[i] = pn_[i];
     for (const PressureConstraint& bc : sim_.constraints_.pressure)
       bc.for_values(t + h, [&](std::int64_t i, double v) { p_[static_cast<std::size_t>(i)] = v; });
+    for (std::int64_t i : seepage_)
+      if (held_[static_cast<std::size_t>(i)]) p_[static_cast<std::size_t>(i)] = 0.0;
     // External nodal forces at t + h: tractions (gravity is per particle).
     for (std::size_t i = 0; i < nodes; ++i) grid.force[i].setZero();
     apply_dead_loads(t + h);
@@ -364,11 +371,31 @@ class QuasiStaticScheme final : public TimeScheme {
       const bool converged = assemble(h, /*jacobian=*/it < c.max_iterations);
       history_[static_cast<std::size_t>(it)] = std::max(last_ru_, last_rp_);
       if (converged) {
+        // Seepage faces: an active set. Each step starts with every face
+        // node free (no water enters a free node); a converged step that
+        // raises a free face node above p = 0 holds it there (its water
+        // leaves) and is solved again, until no free face node is above
+        // zero: the explicit scheme's rule, p <= 0, outflow >= 0, per step.
+        bool held = false;
+        for (std::int64_t i : seepage_) {
+          const auto u = static_cast<std::size_t>(i);
+          if (held_[u] || pdof_[u] < 0 || !(p_[u] > 0.0)) continue;
+          held_[u] = 1;
+          held = true;
+        }
+        if (held) {
+          prepared_ = false;  // the held nodes leave the unknowns
+          return attempt(t, h);
+        }
         if (it > max_nonlinear_ || worst_.empty())
           worst_.assign(history_.begin(), history_.begin() + it + 1);
         max_nonlinear_ = std::max(max_nonlinear_, it);
         if (sim_.reactions_due_) tally_reactions();
         commit(h);
+        if (!seepage_.empty()) {
+          std::fill(held_.begin(), held_.end(), 0);
+          prepared_ = false;
+        }
         return !sim_.failed_;
       }
       if (it >= c.max_iterations) return false;
@@ -618,7 +645,12 @@ class QuasiStaticScheme final : public TimeScheme {
           const double r2 = vol * s.w[k] * div;
           const double r3 = h * vol * kg * gk.dot(flow);
           rhs[dp] += r1 + r2 + r3;
-          ref[dp] += std::abs(r1) + std::abs(r2) + std::abs(r3);
+          // The Darcy term by its two parts: at rest under gravity they
+          // cancel (hydrostatic p), and a reference of their sum alone
+          // would be round-off, which Newton cannot beat.
+          ref[dp] += std::abs(r1) + std::abs(r2) +
+                     h * vol * kg *
+                         (std::abs(gk.dot(grad_p)) + mc.fluid_density * std::abs(gk.dot(gravity)));
         }
       }
       if (!jacobian) continue;
@@ -741,6 +773,8 @@ class QuasiStaticScheme final : public TimeScheme {
   double nominal_ = 0.0;
   double e_ref_ = 0.0;
   bool prepared_ = false;
+  std::vector<std::int64_t> seepage_;  ///< seepage face nodes
+  std::vector<std::uint8_t> held_;     ///< per node: a face node held at p = 0 this step
   std::int64_t unknowns_ = 0;
 
   std::vector<double> weight_, weight_fluid_, pn_, du_, p_;
