@@ -63,8 +63,11 @@ RunResult Simulation<Dim, Shape>::run(const RunOptions& options) {
   const std::size_t stages = stage_count(job_);
   // Every stage's estimated steps (progress); a stage's scheme says its own.
   std::int64_t total = 0;
-  for (std::size_t k = 0; k < stages; ++k)
-    total += std::max<std::int64_t>(1, stable_step(stage_problem(job_, k)).steps);
+  for (std::size_t k = 0; k < stages; ++k) {
+    const StableStep step = stable_step(stage_problem(job_, k));
+    total += std::max<std::int64_t>(1, step.steps);
+    if (k == 0) result.dt = step.chosen;  // the first stage's (also when resumed later)
+  }
   const double end = stage_problem(job_, stages - 1).time.end;  // the job's end
   result.scheme = scheme_name(job_.time.scheme);
   double min_mass = std::numeric_limits<double>::infinity();
@@ -299,7 +302,6 @@ RunResult Simulation<Dim, Shape>::run(const RunOptions& options) {
             " bytes more than this run's state");
       resume.reset();
     }
-    if (k == 0) result.dt = stable_.chosen;
     // Fixed steps: step j of the stage ends at start + (j + 1) dt, the last
     // at the stage's end exactly. Varying steps (quasi_static growth): the
     // scheme says each length.
