@@ -92,6 +92,13 @@ JobOutcome run_job(const ParsedJob& job, const fs::path& out_dir, const hmpm::Ru
         [&](const fs::path& p, const auto& h) { write_profiles_json(p, h, job.profiles); },
         [&](const fs::path& p, const auto& h) { write_profiles_csv(p, h, job.profiles); },
         outcome.run.profiles);
+  if (out.consolidation.interval > 0)
+    write_history(
+        "consolidation",
+        [&](const fs::path& p, const auto& h) {
+          write_consolidation_json(p, h, out.consolidation.from);
+        },
+        write_consolidation_csv, outcome.run.consolidation);
   if (!write_error.empty()) {
     // Partial results are removed: they hold the space a full disk needs,
     // and a set of snapshots without the rest is no result.

@@ -69,6 +69,16 @@ void write_profiles_json(const std::filesystem::path& path, const std::vector<Se
 void write_profiles_csv(const std::filesystem::path& path, const std::vector<Series>& profiles,
                         const std::vector<ProfileGeometry>& geometry);
 
+/// consolidation.json: {"from", "t50", "t90", "time": [...], "degree": [...],
+/// "average_excess_pore_pressure": [...], "volume": [...]}: output.consolidation.
+void write_consolidation_json(const std::filesystem::path& path,
+                              const RunResult::Consolidation& consolidation, double from);
+
+/// consolidation.csv: "time,degree,average_excess_pore_pressure,volume", one
+/// row per sample.
+void write_consolidation_csv(const std::filesystem::path& path,
+                             const RunResult::Consolidation& consolidation);
+
 /// One snapshot as a VTK UnstructuredGrid (.vtu): one vertex cell per
 /// particle, Points = positions, PointData = the snapshot's fields plus
 /// volume and material; base64-encoded little-endian binary, uncompressed.

@@ -24,6 +24,8 @@ std::uint64_t fingerprint(const Problem& problem, const std::string& key) {
   mix(problem.output.reactions_interval);
   mix(problem.output.profile_interval);
   mix(problem.output.profiles.size());
+  mix(problem.output.consolidation.interval);
+  mix(problem.output.consolidation.from);
   mix(problem.stages.size());
   for (const Stage& s : problem.stages) mix(s.end);
   return h;

@@ -17,6 +17,8 @@
 //            asked for), one array per boundary
 //   profiles f64 next profile time, u64 line count, per line its sample
 //            times and one array per field
+//   consolidation  f64 next sample time, arrays of its sample times, excess
+//            and volume
 //   stages   u64 the stage in force (0: the first), the iteration counts of
 //            the stages before it (i64 nonlinear, linear, solves, cutbacks,
 //            i32 most in a step, array of that step's residuals)
@@ -45,8 +47,8 @@ namespace hmpm::checkpoint {
 
 inline constexpr char magic[8] = {'H', 'M', 'P', 'M', 'C', 'K', 'P', 'T'};
 /// 2: reactions; 3: plastic strain, profiles; 4: stages (the stage in
-/// force, the iterations of those before, particle ids)
-inline constexpr std::uint32_t version = 4;
+/// force, the iterations of those before, particle ids); 5: consolidation
+inline constexpr std::uint32_t version = 5;
 
 /// FNV-1a, 64 bits, continuing from `h`.
 inline std::uint64_t fnv1a(const char* data, std::size_t n,

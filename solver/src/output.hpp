@@ -2,6 +2,8 @@
 // fields and the time series of selected particles (internal).
 #pragma once
 
+#include <algorithm>
+#include <cmath>
 #include <limits>
 #include <vector>
 
@@ -131,6 +133,64 @@ void Simulation<Dim, Shape>::sample_series(Series& series, double t) const {
       }
     }
   }
+}
+
+template <int Dim, class Shape>
+void Simulation<Dim, Shape>::sample_consolidation(RunResult::Consolidation& c,
+                                                  const std::vector<std::int64_t>& counted,
+                                                  double t) const {
+  const FieldOfPosition& steady = job_.output.consolidation.steady_pore_pressure;
+  double excess = 0.0, volume = 0.0;
+  for (std::int64_t pi : counted) {
+    // A staged job numbers particles as the job does; one out of the run
+    // (a body not added yet, or removed) does not count.
+    const std::int64_t slot = slot_.empty() ? pi : slot_[static_cast<std::size_t>(pi)];
+    if (slot < 0) continue;
+    const auto p = static_cast<std::size_t>(slot);
+    const MaterialConstants& m = constants_[particles_.material[p]];
+    if (!m.saturated || particles_.pressure_out.empty()) continue;
+    const double v0 = particles_.mass[p] / m.mixture_density;
+    double ps = 0.0;
+    if (steady) {
+      Vec3 x{0.0, 0.0, 0.0};
+      for (int a = 0; a < Dim; ++a) x[a] = particles_.x[p][a];
+      ps = steady(x);
+    }
+    excess += (particles_.pressure_out[p] - ps) * v0;
+    volume += v0;
+  }
+  c.time.push_back(t);
+  c.excess.push_back(excess);
+  c.volume.push_back(volume);
+}
+
+/// The degree of consolidation of every sample of `c` from its excess, and
+/// the times it reaches 50 % and 90 %. An excess at the first sample (at
+/// `from`) below a millionth of the largest later one, or averaging below
+/// 1e-6 Pa, counts as none: nothing to consolidate (every degree NaN;
+/// returns false).
+inline bool finish_consolidation(RunResult::Consolidation& c) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  c.degree.assign(c.time.size(), nan);
+  c.t50 = c.t90 = nan;
+  if (c.excess.empty()) return true;
+  const double e0 = c.excess.front();
+  double largest = 0.0;
+  for (double e : c.excess) largest = std::max(largest, std::abs(e));
+  if (!std::isfinite(e0) || !(std::abs(e0) > 1e-6 * largest) ||
+      !(std::abs(e0) > 1e-6 * c.volume.front()))
+    return false;
+  for (std::size_t k = 0; k < c.time.size(); ++k) c.degree[k] = 1.0 - c.excess[k] / e0;
+  auto first_reaching = [&](double u) {
+    for (std::size_t k = 1; k < c.time.size(); ++k)
+      if (c.degree[k] >= u && c.degree[k - 1] < u)
+        return c.time[k - 1] + (u - c.degree[k - 1]) / (c.degree[k] - c.degree[k - 1]) *
+                                   (c.time[k] - c.time[k - 1]);
+    return nan;
+  };
+  c.t50 = first_reaching(0.5);
+  c.t90 = first_reaching(0.9);
+  return true;
 }
 
 }  // namespace hmpm

@@ -268,6 +268,10 @@ bool particle_selected(const Problem& problem, const Flux& flux, const Vec3& x) 
   return in_selection(problem, flux.particles, flux.polygon, x);
 }
 
+bool particle_selected(const Problem& problem, const ConsolidationRequest& c, const Vec3& x) {
+  return c.all || in_selection(problem, c.particles, c.polygon, x);
+}
+
 std::vector<Vec3> initial_positions(const Problem& problem) {
   std::vector<Vec3> out;
   for (const BodyLayout& l : body_layouts(problem))
@@ -677,6 +681,41 @@ void check_stages(const Problem& problem, std::vector<ProblemIssue>& issues) {
 
 }  // namespace
 
+// output.consolidation: pore water to drain, a reference instant inside
+// the run, and a selection that holds some of it.
+void check_consolidation(const Problem& problem, std::vector<ProblemIssue>& issues) {
+  const ConsolidationRequest& c = problem.output.consolidation;
+  if (!(c.interval > 0)) return;
+  const Location w{"output", "consolidation"};
+  std::vector<bool> wet(problem.materials.size());
+  for (std::size_t m = 0; m < wet.size(); ++m) wet[m] = problem.materials[m].hydraulic.has_value();
+  if (std::find(wet.begin(), wet.end(), true) == wet.end()) {
+    issues.push_back({w,
+                      "needs pore water, but no material has `hydraulic` (a dry run has no "
+                      "pore pressure to dissipate): give the soil's material a hydraulic "
+                      "section or remove output.consolidation"});
+    return;
+  }
+  const double end = problem.stages.empty() ? problem.time.end : problem.stages.back().end;
+  if (!(c.from >= 0 && c.from < end))
+    issues.push_back({w / "from", "is " + fmt(c.from) + " s; it must be in [0, " + fmt(end) +
+                                      ") s, inside the run (the job ends at t = " + fmt(end) +
+                                      " s)"});
+  if (c.all) return;
+  std::int64_t held = 0;
+  const std::vector<BodyLayout> layouts = body_layouts(problem);
+  for (std::size_t b = 0; b < layouts.size() && b < problem.bodies.size(); ++b) {
+    const auto m = static_cast<std::size_t>(problem.bodies[b].material);
+    if (m >= wet.size() || !wet[m]) continue;
+    for (const Vec3& x : layouts[b].positions)
+      if (particle_selected(problem, c, x)) ++held;
+  }
+  if (held == 0)
+    issues.push_back({w / "particles",
+                      "selects no particle with pore water: widen the box or polygon to hold "
+                      "the consolidating ground, or leave 'particles' out to count every one"});
+}
+
 std::vector<ProblemIssue> check_problem(const Problem& problem) {
   std::vector<ProblemIssue> issues;
   auto add = [&](Location where, std::string msg) {
@@ -801,6 +840,7 @@ std::vector<ProblemIssue> check_problem(const Problem& problem) {
   }
   if (!out.profiles.empty() && !(out.profile_interval > 0))
     add({"output", "profiles", "interval"}, "must be > 0");
+  check_consolidation(problem, issues);
   const bool adds = std::any_of(problem.stages.begin(), problem.stages.end(),
                                 [](const Stage& st) { return !st.add_bodies.empty(); });
   for (ProblemIssue& issue : check_geostatic(adds ? initial_ground(problem) : problem))

@@ -262,6 +262,10 @@ class Simulation {
   // ------------------------------------------------------------ output (output.hpp)
   void fill_snapshot(Snapshot& snap, const std::vector<Field>& fields) const;
   void sample_series(Series& series, double t) const;
+  /// Appends the excess pore pressure of `counted` (job particle indices)
+  /// at time t to `c` (OutputRequest::consolidation).
+  void sample_consolidation(RunResult::Consolidation& c, const std::vector<std::int64_t>& counted,
+                            double t) const;
 
   const Problem& job_;  ///< the job as given, every stage (Problem::stages)
   /// The Problem in force: stage_problem(job_, stage_) (stages.hpp).

@@ -121,6 +121,18 @@ RunResult Simulation<Dim, Shape>::run(const RunOptions& options) {
       start_series(profiles[l], out.profiles[l].particles, out.profiles[l].fields);
   }
   double next_profile = out.profile_interval;
+  // Consolidation: the excess of the counted particles (job indices) at
+  // `from`, then every interval after it.
+  const ConsolidationRequest& cr = out.consolidation;
+  RunResult::Consolidation& consolidation = result.consolidation;
+  const bool want_consolidation = cr.interval > 0;
+  std::vector<std::int64_t> counted;
+  if (want_consolidation) {
+    const std::vector<Vec3> x0 = initial_positions(job_);
+    for (std::size_t pi = 0; pi < x0.size(); ++pi)
+      if (particle_selected(job_, cr, x0[pi])) counted.push_back(static_cast<std::int64_t>(pi));
+  }
+  double next_consolidation = cr.from > 0 ? cr.from : cr.interval;
   // Reactions: one vector per boundary (the most any stage has) per sample,
   // the first at t = interval (a step's reaction needs the step). A boundary
   // a stage does not have exerts no force.
@@ -194,6 +206,12 @@ RunResult Simulation<Dim, Shape>::run(const RunOptions& options) {
       r.array(s.time, -1, "profile times");
       for (std::vector<double>& v : s.values) r.array(v, -1, "profile values");
     }
+    next_consolidation = r.pod<double>();
+    r.array(consolidation.time, -1, "consolidation times");
+    r.array(consolidation.excess, static_cast<std::int64_t>(consolidation.time.size()),
+            "consolidation excess");
+    r.array(consolidation.volume, static_cast<std::int64_t>(consolidation.time.size()),
+            "consolidation volume");
     first_stage = static_cast<std::size_t>(r.pod<std::uint64_t>());
     if (first_stage >= stages)
       throw std::invalid_argument("the checkpoint is in stage " + std::to_string(first_stage) +
@@ -211,6 +229,7 @@ RunResult Simulation<Dim, Shape>::run(const RunOptions& options) {
   } else {
     if (want_series) sample_series(series, 0.0);
     for (Series& s : profiles) sample_series(s, 0.0);
+    if (want_consolidation && !(cr.from > 0)) sample_consolidation(consolidation, counted, 0.0);
     if (want_snapshots) take_snapshot(0.0);
   }
 
@@ -256,6 +275,10 @@ RunResult Simulation<Dim, Shape>::run(const RunOptions& options) {
       w.array(s.time);
       for (const std::vector<double>& v : s.values) w.array(v);
     }
+    w.pod(next_consolidation);
+    w.array(consolidation.time);
+    w.array(consolidation.excess);
+    w.array(consolidation.volume);
     w.pod(static_cast<std::uint64_t>(stage_));
     w.pod(done_iterations.nonlinear);
     w.pod(done_iterations.linear);
@@ -381,6 +404,10 @@ RunResult Simulation<Dim, Shape>::run(const RunOptions& options) {
         for (Series& s : profiles) sample_series(s, t);
         while (next_profile <= t + eps_t) next_profile += out.profile_interval;
       }
+      if (want_consolidation && t >= next_consolidation - eps_t) {
+        sample_consolidation(consolidation, counted, t);
+        while (next_consolidation <= t + eps_t) next_consolidation += cr.interval;
+      }
       if (want_snapshots && t >= next_snapshot - eps_t) {
         take_snapshot(t);
         while (next_snapshot <= t + eps_t) next_snapshot += out.snapshot_interval;
@@ -417,6 +444,14 @@ RunResult Simulation<Dim, Shape>::run(const RunOptions& options) {
     time_scheme.report(part);
     add_iterations(done_iterations, part.iterations);
   }
+  if (want_consolidation && !finish_consolidation(consolidation))
+    result.run_warnings.push_back(
+        "output.consolidation: the excess pore pressure at t = " +
+        number(consolidation.time.empty() ? cr.from : consolidation.time.front()) +
+        " s is about zero, so the degree of consolidation is undefined (null). What to change: "
+        "set output.consolidation.from to the end of the loading (a load applied at t = 0 "
+        "builds its excess in the first step), and steady_pore_pressure to the pore pressure "
+        "the ground drains to (hydrostatic under gravity)");
   const double seconds =
       seconds_before + std::chrono::duration<double>(Clock::now() - start).count();
   result.warnings.insert(result.warnings.end(), result.run_warnings.begin(),

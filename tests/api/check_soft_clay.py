@@ -24,6 +24,12 @@ column, so the isochrones):
   (the top particle's centre is h/2 below the surface, so its displacement
   misses the compression of the last half cell: up to 1.25 % of U, which
   the closed form at x_top accounts for instead of the tolerance).
+- the average degree of consolidation (output.consolidation, from the pore
+  pressure: no gravity, so the excess is p; the first sample at t = 0, where
+  the water carries the whole load) within 0.01 of Terzaghi's U(T_v) at
+  every sample in T_v 0.05..0.848, t50 within 2.5 % of Terzaghi's (an error
+  of 0.5 % in U moves it by 2 %: 0.005 / (T_v U'(T_v)) at T_v = 0.197), and
+  consolidation.csv holding the same numbers.
 Tolerances: 1 % is issue 16's acceptance. What the discretisation leaves
 (measured on the same set-up by tests/solver/test_quasi_static.cpp and here,
 printed below): backward Euler's time error at the diffusion front at
@@ -148,6 +154,33 @@ def main():
           f"points; max |p - p_exact|/q = {worst_profile:.4f} (interior)")
     if profile_rows < 8:
         problems.append(f"only {profile_rows} profile times in T_v 0.05..0.848")
+    # The degree of consolidation (consolidation.json, read back with its CSV).
+    with open(os.path.join(out, "consolidation.json")) as f:
+        con = json.load(f)
+    worst_c, con_rows = 0.0, 0
+    for t, u in zip(con["time"], con["degree"]):
+        tv = c_v * t / height ** 2
+        if tv < 0.05 - 1e-9 or tv > 0.848 + 1e-9:
+            continue
+        con_rows += 1
+        worst_c = max(worst_c, abs(u - degree(tv)))
+    if con["time"][0] != 0 or con["degree"][0] != 0:
+        problems.append(f"consolidation starts at t = {con['time'][0]} with U = {con['degree'][0]}")
+    if worst_c > 0.01 or con_rows < 10:
+        problems.append(f"degree of consolidation: max |U - U_exact| = {worst_c:.4f} over "
+                        f"{con_rows} samples")
+    t50 = 0.196731 * height ** 2 / c_v
+    if con["t50"] is None or abs(con["t50"] / t50 - 1) > 0.025:
+        problems.append(f"t50 = {con['t50']} s, Terzaghi {t50:.6g} s")
+    with open(os.path.join(out, "consolidation.csv")) as f:
+        con_csv = [r.split(",") for r in f.read().splitlines()]
+    if (con_csv[0] != ["time", "degree", "average_excess_pore_pressure", "volume"]
+            or len(con_csv) - 1 != len(con["time"])
+            or abs(float(con_csv[-1][1]) - con["degree"][-1]) > 1e-9):
+        problems.append(f"consolidation.csv differs from consolidation.json: {con_csv[:2]}")
+    print(f"soft clay consolidation: {con_rows} samples in T_v 0.05..0.848; max |U - U_exact| = "
+          f"{worst_c:.4f}; t50 {con['t50']:.6g} s against {t50:.6g} s; U at the end "
+          f"{con['degree'][-1]:.4f}")
     tv_end = c_v * series["time"][-1] / height ** 2
     print(f"soft clay: {rows} rows over T_v 0.05..{tv_end:.3f}; max |p - p_exact|/q = "
           f"{worst_p:.4f} (interior), max |U_h - U_exact(x_top)| = {worst_u:.4f} "

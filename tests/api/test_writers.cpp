@@ -194,6 +194,33 @@ TEST(Writers, ProfilesHaveTheirPointsDistancesAndRows) {
             "0.5,1,1,2,,7,8\n");
 }
 
+// consolidation.json and consolidation.csv: the degree, the average excess
+// (E / V), t50 and t90 (null when not reached).
+TEST(Writers, ConsolidationHasDegreeAverageExcessAndItsTimes) {
+  testing::TempDir dir;
+  RunResult::Consolidation c;
+  c.time = {10.0, 20.0, 30.0};
+  c.excess = {100.0, 40.0, 20.0};
+  c.volume = {2.0, 2.0, 2.0};
+  c.degree = {0.0, 0.6, 0.8};
+  c.t50 = 18.0;  // t90 stays NaN: not reached
+  write_consolidation_json(dir.path() / "consolidation.json", c, 10.0);
+  write_consolidation_csv(dir.path() / "consolidation.csv", c);
+  const json j = json::parse(testing::read_text(dir.path() / "consolidation.json"));
+  EXPECT_EQ(j["from"], 10.0);
+  EXPECT_EQ(j["t50"], 18.0);
+  EXPECT_TRUE(j["t90"].is_null());
+  EXPECT_EQ(j["time"], json({10.0, 20.0, 30.0}));
+  EXPECT_EQ(j["degree"], json({0.0, 0.6, 0.8}));
+  EXPECT_EQ(j["average_excess_pore_pressure"], json({50.0, 20.0, 10.0}));
+  EXPECT_EQ(j["volume"], json({2.0, 2.0, 2.0}));
+  EXPECT_EQ(testing::read_text(dir.path() / "consolidation.csv"),
+            "time,degree,average_excess_pore_pressure,volume\n"
+            "10,0,50,2\n"
+            "20,0.6,20,2\n"
+            "30,0.8,10,2\n");
+}
+
 TEST(Writers, SnapshotsReadBackWithMeshio) {
   testing::TempDir dir;
   std::vector<std::pair<double, std::string>> entries;

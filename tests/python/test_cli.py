@@ -177,6 +177,17 @@ class CliTest(LiveServerCase):
                      "--out", str(self.tmp / "x.png")], timeout=60)
         self.assertEqual(r.returncode, 1)
         self.assertIn("it has: pore_pressure", r.stderr)
+        # Its degree of consolidation (output.consolidation), likewise.
+        png = self.tmp / "consolidation.png"
+        r = run_cli(["--url", "http://127.0.0.1:9", "plot", str(out), "--consolidation",
+                     "--out", str(png)], timeout=60)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        self.assertEqual(png.read_bytes()[:8], b"\x89PNG\r\n\x1a\n")
+        r = run_cli(["plot", str(self.tmp), "--consolidation", "--out", str(self.tmp / "x.png")],
+                    timeout=60)
+        self.assertEqual(r.returncode, 1)
+        self.assertIn("no consolidation.json", r.stderr)
+        self.assertIn("output.consolidation", r.stderr)
 
     def test_status_takes_the_8_characters_the_progress_bar_prints(self):
         job_id = self.submit_and_wait(bar_spec())

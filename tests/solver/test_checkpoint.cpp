@@ -82,6 +82,11 @@ hmpm::Problem block(hmpm::Scheme scheme) {
   p.output.profiles = {{{1, 2, 3}, {hmpm::Field::pore_pressure}},
                        {{4, 5}, {hmpm::Field::displacement, hmpm::Field::strain}}};
   p.output.profile_interval = 1.5 * p.output.series_interval;
+  // And the degree of consolidation, from a reference instant after t = 0.
+  if (!p.materials.empty() && p.materials[0].hydraulic) {
+    p.output.consolidation.interval = 1.25 * p.output.series_interval;
+    p.output.consolidation.from = 0.5 * p.output.series_interval;
+  }
   return p;
 }
 
@@ -196,6 +201,12 @@ void expect_resume_as_whole(const hmpm::Problem& p, const char* label, double fr
     EXPECT_EQ(resumed.result.profiles[l].time, whole.result.profiles[l].time);
     EXPECT_EQ(resumed.result.profiles[l].values, whole.result.profiles[l].values);
   }
+  const hmpm::RunResult::Consolidation &ca = resumed.result.consolidation,
+                                       &cb = whole.result.consolidation;
+  ASSERT_GE(cb.time.size(), 3u);  // every variant has pore water
+  EXPECT_EQ(ca.time, cb.time);
+  EXPECT_TRUE(same_bits({ca.excess, ca.degree, {ca.t50, ca.t90}},
+                        {cb.excess, cb.degree, {cb.t50, cb.t90}}));
   const auto &ia = resumed.result.iterations, &ib = whole.result.iterations;
   EXPECT_EQ(ia.nonlinear, ib.nonlinear);
   EXPECT_EQ(ia.linear, ib.linear);

@@ -372,11 +372,59 @@ void check_limits(ParseContext& c) {
 
 }  // namespace
 
+// output.consolidation without steady_pore_pressure: the hydrostatic
+// pressure under the geostatic water table when the job has one, else 0
+// (with a warning when gravity acts on the pore water).
+void resolve_consolidation(ParseContext& c) {
+  ConsolidationRequest& out = c.p.output.consolidation;
+  if (!c.consolidation_hydrostatic || !(out.interval > 0)) return;
+  const std::string path = "/output/consolidation";
+  int axis = -1;
+  for (int a = 0; a < 3; ++a)
+    if (c.p.gravity[a] != 0) axis = a;
+  std::optional<double> rho_f;
+  bool mixed = false;
+  for (const Material& m : c.p.materials)
+    if (m.hydraulic) {
+      if (rho_f && *rho_f != m.hydraulic->fluid_density) mixed = true;
+      if (!rho_f) rho_f = m.hydraulic->fluid_density;
+    }
+  if (axis < 0 || !rho_f) return;  // no weight of water, or no water: the excess is p itself
+  const auto& geo = c.p.initial_state.geostatic;
+  if (!geo || !geo->water_table) {
+    const std::string ax(axis_names[axis]);
+    std::string advice =
+        "has no steady_pore_pressure, so the excess pore pressure is measured from 0, but "
+        "gravity acts on the pore water: the hydrostatic pressure would count as excess. Give "
+        "steady_pore_pressure the pressure the ground drains to, e.g. \"";
+    advice.append(format_number(*rho_f * std::abs(c.p.gravity[axis])))
+        .append("*(WT - ")
+        .append(ax)
+        .append(")\" with WT the water table's ")
+        .append(ax);
+    c.warnings.push_back({path, advice});
+    return;
+  }
+  if (mixed) {
+    c.r.error(path,
+              "needs steady_pore_pressure: its default, the hydrostatic pressure under "
+              "the water table, is ambiguous when the materials' fluid densities differ");
+    return;
+  }
+  const double gamma = *rho_f * std::abs(c.p.gravity[axis]);
+  const double up = c.p.gravity[axis] < 0 ? 1.0 : -1.0;  // "above" is against gravity
+  const double table = *geo->water_table;
+  out.steady_pore_pressure = [gamma, up, table, axis](const Vec3& x) {
+    return gamma * up * (table - x[static_cast<std::size_t>(axis)]);
+  };
+}
+
 void check_whole_problem(ParseContext& c) {
   if (!check_particle_budget(c)) return;
   resolve_near(c);
   resolve_series_polygons(c);
   resolve_profiles(c);
+  resolve_consolidation(c);
   for (const ProblemIssue& issue : check_problem(c.p))
     c.r.error(pointer_of_solver_location(issue.where), issue.message);
   if (c.r.error_count() > 0) return;

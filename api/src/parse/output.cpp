@@ -9,7 +9,8 @@
 namespace hmpm::api::parse {
 namespace {
 
-constexpr std::string_view output_allowed[] = {"series", "snapshots", "reactions", "profiles"};
+constexpr std::string_view output_allowed[] = {"series", "snapshots", "reactions", "profiles",
+                                               "consolidation"};
 constexpr std::string_view profiles_allowed[] = {"interval", "lines"};
 constexpr std::string_view line_allowed[] = {"from", "to", "points", "fields"};
 constexpr std::string_view series_allowed[] = {"particles", "fields", "interval"};
@@ -19,6 +20,9 @@ constexpr std::string_view snapshots_allowed[] = {"interval", "fields"};
 constexpr std::string_view snapshots_required[] = {"interval"};
 constexpr std::string_view reactions_allowed[] = {"interval"};
 constexpr std::string_view reactions_required[] = {"interval"};
+constexpr std::string_view consolidation_allowed[] = {"interval", "from", "steady_pore_pressure",
+                                                      "particles"};
+constexpr std::string_view consolidation_required[] = {"interval"};
 
 std::vector<Field> read_fields(SpecReader& r, const json& j, const std::string& path) {
   std::vector<Field> out;
@@ -119,6 +123,30 @@ void read_profiles(ParseContext& c, const json& j, const std::string& path) {
   }
 }
 
+// output.consolidation: {"interval", "from", "steady_pore_pressure",
+// "particles"}. Without steady_pore_pressure: the hydrostatic pressure
+// under the geostatic state's water table when the job has one (gravity
+// and the fluid density of the first material with pore water), else 0.
+void read_consolidation(ParseContext& c, const json& j, const std::string& path) {
+  SpecReader& r = c.r;
+  ConsolidationRequest& out = c.p.output.consolidation;
+  if (!r.object(j, path, consolidation_allowed, consolidation_required)) return;
+  r.number_at(j, path, "interval", Range::positive(), out.interval);
+  r.number_at(j, path, "from", Range::non_negative(), out.from);
+  if (j.contains("steady_pore_pressure"))
+    out.steady_pore_pressure =
+        read_value_of_position(c, j["steady_pore_pressure"], path + "/steady_pore_pressure");
+  else
+    c.consolidation_hydrostatic = true;  // resolved with the whole problem (checks.cpp)
+  if (j.contains("particles")) {
+    bool all = false;
+    if (auto box = read_selection(c, j["particles"], path + "/particles", all, &out.polygon)) {
+      out.particles = *box;
+      out.all = all;
+    }
+  }
+}
+
 }  // namespace
 
 Keys field_names() {
@@ -139,6 +167,7 @@ void output_keys(std::vector<SpecObjectKeys>& out) {
   out.push_back(keys_entry("/output/reactions", reactions_allowed));
   out.push_back(keys_entry("/output/profiles", profiles_allowed));
   out.push_back(keys_entry("/output/profiles/lines/*", line_allowed));
+  out.push_back(keys_entry("/output/consolidation", consolidation_allowed));
 }
 
 void read_output(ParseContext& c, const json& j, const std::string& path) {
@@ -170,6 +199,8 @@ void read_output(ParseContext& c, const json& j, const std::string& path) {
     }
   }
   if (j.contains("profiles")) read_profiles(c, j["profiles"], path + "/profiles");
+  if (j.contains("consolidation"))
+    read_consolidation(c, j["consolidation"], path + "/consolidation");
   if (j.contains("reactions")) {
     const json& s = j["reactions"];
     const std::string sp = path + "/reactions";

@@ -82,6 +82,8 @@ struct ParseContext {
   std::size_t formulas = 0;             ///< formulas read so far
   std::vector<std::string> traction_paths;
   std::vector<std::string> flux_paths;  ///< "/fluxes/i/particles", for selection errors
+  /// output.consolidation without steady_pore_pressure (resolve_consolidation)
+  bool consolidation_hydrostatic = false;
   bool any_pore_pressure_bc = false;
   std::string first_pore_pressure_bc;
   /// Runnable but worth knowing (e.g. time.implicit with the explicit

@@ -5,7 +5,7 @@
     python3 -m hmpm_client --url URL wait ID | results ID | download ID DIR | log ID
     python3 -m hmpm_client --url URL cancel ID     # stop a queued/running job, keep its files
     python3 -m hmpm_client --url URL delete ID     # dismiss a job and delete its files
-    python3 -m hmpm_client --url URL plot ID|DIR --field pore_pressure [--out FILE.png] [--profile LINE]
+    python3 -m hmpm_client --url URL plot ID|DIR --field pore_pressure [--out FILE.png] [--profile LINE | --consolidation]
 
 `plot` takes a job id, or a local folder holding series.json (what
 `download` or `hmpm run --out` wrote), so no service is needed for it.
@@ -95,6 +95,9 @@ def _parser() -> argparse.ArgumentParser:
     s.add_argument("--profile", metavar="LINE", type=int,
                    help="plot line LINE of profiles.json (the field along the line, a curve per "
                         "time) instead of the series")
+    s.add_argument("--consolidation", action="store_true",
+                   help="plot consolidation.json (the average degree of consolidation and the "
+                        "average excess pore pressure over time) instead of the series")
     return p
 
 
@@ -215,12 +218,22 @@ def cmd_download(client: Client, args) -> int:
 
 
 def cmd_plot(client: Client, args) -> int:
-    from .plot import MatplotlibMissing, plot_profile, plot_series
+    from .plot import MatplotlibMissing, plot_consolidation, plot_profile, plot_series
     local = Path(args.id)
     label = local.name if local.is_dir() else args.id
     profile = args.profile is not None
-    name, section = ("profiles.json", "output.profiles") if profile else ("series.json", "output.series")
-    out = Path(args.out or f"{label}-{args.field}{f'-profile{args.profile}' if profile else ''}.png")
+    if profile and args.consolidation:
+        _err("give --profile or --consolidation, not both")
+        return EXIT_ERROR
+    if args.consolidation:
+        name, section = "consolidation.json", "output.consolidation"
+        out = Path(args.out or f"{label}-consolidation.png")
+    elif profile:
+        name, section = "profiles.json", "output.profiles"
+        out = Path(args.out or f"{label}-{args.field}-profile{args.profile}.png")
+    else:
+        name, section = "series.json", "output.series"
+        out = Path(args.out or f"{label}-{args.field}.png")
     try:
         if local.is_dir():
             path = local / name
@@ -231,9 +244,11 @@ def cmd_plot(client: Client, args) -> int:
             title = f"{local}: {args.field}"
         else:
             job = client.job(args.id)
-            doc = json.loads(job.read_result(name)) if profile else job.series()
+            doc = json.loads(job.read_result(name)) if name != "series.json" else job.series()
             title = f"job {args.id}: {args.field}"
-        if profile:
+        if args.consolidation:
+            plot_consolidation(doc, out, title=title.split(": ")[0] + ": degree of consolidation")
+        elif profile:
             plot_profile(doc, args.field, out, line=args.profile, title=title + f", profile {args.profile}")
         else:
             plot_series(doc, args.field, out, title=title)

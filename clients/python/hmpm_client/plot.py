@@ -166,3 +166,47 @@ def plot_profile(profiles: Dict[str, Any], field: str, out: Path, line: int = 0,
     axes[0][-1].legend(fontsize="x-small", loc="best")
     fig.suptitle(title or f"{field} along profile {line}")
     return _save(plt, fig, out)
+
+
+def plot_consolidation(doc: Dict[str, Any], out: Path, title: Optional[str] = None) -> Path:
+    """Writes a PNG of consolidation.json: the average degree of
+    consolidation U against time (log scale, U growing downwards as in a
+    settlement curve), with t50 and t90 marked, and the average excess pore
+    pressure beside it.
+
+    Raises MatplotlibMissing without matplotlib, and ValueError when U is
+    undefined in every sample (no excess at `from`).
+    """
+    times = doc.get("time") or []
+    degree = doc.get("degree") or []
+    pairs = [(t, u) for t, u in zip(times, degree) if u is not None and t > 0]
+    if not pairs:
+        raise ValueError("consolidation.json has no degree of consolidation (null in every "
+                         "sample: the excess at 'from' was zero; see the run's warnings)")
+    plt = _import_pyplot()
+    fig, axes = plt.subplots(1, 2, figsize=(10.5, 4.2), squeeze=False)
+    ax = axes[0][0]
+    ax.plot([t for t, _ in pairs], [100 * u for _, u in pairs], marker=".", markersize=3)
+    ax.set_xscale("log")
+    ax.set_ylim(105, -5)
+    ax.set_xlabel("time [s]")
+    ax.set_ylabel("average degree of consolidation U [%]")
+    for key, level in (("t50", 50), ("t90", 90)):
+        t = doc.get(key)
+        if t:
+            ax.axhline(level, color="grey", lw=0.6, ls=":")
+            ax.axvline(t, color="grey", lw=0.6, ls=":")
+            ax.annotate(f"{key} = {t:.4g} s", (t, level), textcoords="offset points",
+                        xytext=(4, -10), fontsize="small")
+    ax.grid(True, which="both", alpha=0.3)
+    ax2 = axes[0][1]
+    excess = doc.get("average_excess_pore_pressure") or []
+    ex = [(t, e) for t, e in zip(times, excess) if e is not None and t > 0]
+    ax2.plot([t for t, _ in ex], [e / 1000 for _, e in ex], marker=".", markersize=3, color="C1")
+    ax2.set_xscale("log")
+    ax2.set_xlabel("time [s]")
+    ax2.set_ylabel("average excess pore pressure [kPa]")
+    ax2.grid(True, which="both", alpha=0.3)
+    fig.suptitle(title or "degree of consolidation")
+    return _save(plt, fig, out)
+

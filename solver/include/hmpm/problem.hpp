@@ -340,6 +340,29 @@ struct ProfileLine {
   std::vector<Field> fields;
 };
 
+/// The average degree of consolidation of the ground (output.consolidation
+/// in the job spec): with the excess pore pressure integrated over the
+/// particles' initial volumes,
+///   E(t) = sum over the counted particles of (p - p_steady(x)) V0,
+///   U(t) = 1 - E(t) / E(from),
+/// the fraction of the excess at `from` that has drained (Terzaghi's
+/// average degree of consolidation in 1D). Counted: the particles in the
+/// run whose material has pore water and whose initial position the
+/// selection holds (every one when `all`).
+struct ConsolidationRequest {
+  /// s; > 0: sampled at `from` (t = 0: before the first step; later: at
+  /// the end of the first step that reaches it), then at the end of the
+  /// steps that reach from + k interval.
+  double interval = 0.0;
+  double from = 0.0;  ///< s; the reference instant: U(from) = 0
+  /// Pa, the pore pressure once the consolidation is over (hydrostatic, or
+  /// 0 without gravity), at the particle's current position; empty: 0.
+  FieldOfPosition steady_pore_pressure;
+  bool all = true;                 ///< count every particle with pore water; else the selection:
+  Box particles;                   ///< closed box of initial positions; used when no polygon
+  std::optional<Polygon> polygon;  ///< 2D: replaces the box when set
+};
+
 struct OutputRequest {
   std::vector<std::int64_t> series_particles;  ///< global particle indices
   std::vector<Field> series_fields;
@@ -354,6 +377,7 @@ struct OutputRequest {
   /// steps that reach each multiple of profile_interval (> 0 when any).
   std::vector<ProfileLine> profiles;
   double profile_interval = 0.0;
+  ConsolidationRequest consolidation;  ///< none unless its interval > 0
 };
 
 /// A later stage of a staged job (Problem::stages): from the end of the

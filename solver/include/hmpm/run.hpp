@@ -14,6 +14,7 @@
 #include <cstdint>
 #include <functional>
 #include <initializer_list>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -134,6 +135,9 @@ bool node_selected(const Problem& problem, const NodeSelection& nodes, const Vec
 bool particle_selected(const Problem& problem, const Traction& traction, const Vec3& x);
 /// The same for a flux.
 bool particle_selected(const Problem& problem, const Flux& flux, const Vec3& x);
+/// Whether output.consolidation counts the particle initially at x (its
+/// selection; pore water aside).
+bool particle_selected(const Problem& problem, const ConsolidationRequest& c, const Vec3& x);
 
 /// Index of the particle whose initial position is nearest to `x`; -1 if none.
 std::int64_t nearest_particle(const Problem& problem, const Vec3& x);
@@ -300,6 +304,20 @@ struct RunResult {
   /// One per OutputRequest::profiles line: its particles' fields at each
   /// profile time.
   std::vector<Series> profiles;
+  /// OutputRequest::consolidation: the excess pore pressure of the ground
+  /// and the average degree of consolidation at each sample time.
+  struct Consolidation {
+    std::vector<double> time;    ///< s
+    std::vector<double> excess;  ///< E = sum (p - p_steady) V0, Pa m^3 (per unit area / thickness)
+    std::vector<double> volume;  ///< sum V0 of the counted particles, m^3
+    /// U = 1 - E / E(from) (the first sample is at `from`); NaN (null) in
+    /// every sample when E(from) is zero (nothing to consolidate).
+    std::vector<double> degree;
+    /// s; the first times U reaches 0.5 and 0.9 (linear between samples);
+    /// NaN when it does not.
+    double t50 = std::numeric_limits<double>::quiet_NaN();
+    double t90 = std::numeric_limits<double>::quiet_NaN();
+  } consolidation;
 };
 
 /// Runs `problem` to its end time. See the file comment for failure modes.

@@ -112,10 +112,19 @@ class QuasiStaticScheme final : public TimeScheme {
   double next_dt(double t) override {
     double h = nominal_;
     const OutputRequest& out = sim_.problem_.output;
-    for (double interval : {out.series_interval, out.snapshot_interval, out.reactions_interval,
-                            out.profile_interval}) {
+    const ConsolidationRequest& c = out.consolidation;
+    // (first instant, interval) of each output's samples
+    const std::pair<double, double> samples[] = {{0.0, out.series_interval},
+                                                 {0.0, out.snapshot_interval},
+                                                 {0.0, out.reactions_interval},
+                                                 {0.0, out.profile_interval},
+                                                 {c.from, c.interval}};
+    for (const auto& [first, interval] : samples) {
       if (!(interval > 0)) continue;
-      const double next = (std::floor(t / interval + 1e-9) + 1.0) * interval;
+      const double next =
+          t < first - 1e-9 * interval
+              ? first
+              : first + (std::floor((t - first) / interval + 1e-9) + 1.0) * interval;
       if (t + 1.25 * h >= next - 1e-9 * interval) h = std::min(h * 1.25, next - t);
     }
     nominal_ = std::min(growth_.max, nominal_ * growth_.growth);
