@@ -16,7 +16,8 @@
 # (problem.hpp reaches nearly all files) took CI's tidy stage to 6 minutes.
 # Environment: BUILD_DIR (default build; configured with cmake if it has no
 # compile_commands.json), JOBS (default nproc), CLANG_TIDY (default
-# clang-tidy), TIDY_OUT (also write every finding to this file).
+# clang-tidy), TIDY_OUT (also write every finding to this file), TIDY_LIST
+# (non-empty: list the files checked on stderr).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 root=$PWD
@@ -31,9 +32,30 @@ fi
 if [ ! -f "$build/compile_commands.json" ]; then
   cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=Release >/dev/null
 fi
+out=$(mktemp -d)
+trap 'rm -rf "$out"' EXIT
+# The build's compile commands without its precompiled headers (CMake's
+# `-include .../cmake_pch.hxx`): clang cannot read GCC's .gch files, and the
+# headers they hold are included by the sources themselves.
+# A unity batch (CMake's Unity/unity_N_cxx.cxx, which #includes the
+# target's sources: the api and the server build so) becomes one entry per
+# source it includes, with the batch's command.
+python3 - "$build/compile_commands.json" "$out/compile_commands.json" <<'PY'
+import json, re, sys
+entries = []
+for e in json.load(open(sys.argv[1])):
+    e["command"] = re.sub(r"\s-Winvalid-pch|\s-include\s+\S*cmake_pch\.hxx", "", e["command"])
+    if re.search(r"/Unity/unity_\d+_cxx\.cxx$", e["file"]):
+        for source in re.findall(r'^#include "([^"]+)"', open(e["file"]).read(), re.M):
+            entries.append(dict(e, file=source,
+                                command=e["command"].replace(e["file"], source)))
+    else:
+        entries.append(e)
+json.dump(entries, open(sys.argv[2], "w"))
+PY
 # Tracked .cpp files that have a compile command (fuzz/ only when configured
 # with HMPM_FUZZ=ON).
-mapfile -t compiled < <(python3 - "$build/compile_commands.json" "$root" <<'PY'
+mapfile -t compiled < <(python3 - "$out/compile_commands.json" "$root" <<'PY'
 import json, os, sys
 root = sys.argv[2]
 for entry in json.load(open(sys.argv[1])):
@@ -117,19 +139,8 @@ PY
 else
   files=("${all[@]}")
 fi
-out=$(mktemp -d)
-trap 'rm -rf "$out"' EXIT
-# The build's compile commands without its precompiled headers (CMake's
-# `-include .../cmake_pch.hxx`): clang cannot read GCC's .gch files, and the
-# headers they hold are included by the sources themselves.
-python3 - "$build/compile_commands.json" "$out/compile_commands.json" <<'PY'
-import json, re, sys
-entries = json.load(open(sys.argv[1]))
-for e in entries:
-    e["command"] = re.sub(r"\s-Winvalid-pch|\s-include\s+\S*cmake_pch\.hxx", "", e["command"])
-json.dump(entries, open(sys.argv[2], "w"))
-PY
 echo "check_tidy: ${#files[@]} files, $jobs jobs${base:+, changed since $base}" >&2
+[ -n "${TIDY_LIST:-}" ] && printf '  %s\n' "${files[@]}" >&2
 export clang_tidy out
 printf '%s\n' "${files[@]}" | xargs -P "$jobs" -I{} sh -c \
   '"$clang_tidy" -p "$out" --quiet --extra-arg=-Wno-unknown-warning-option "$1" \

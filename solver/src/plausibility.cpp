@@ -18,10 +18,6 @@ namespace hmpm {
 
 namespace {
 
-std::string fmt(double v) {
-  return format_significant(v, 4);
-}
-
 /// A range of usual values of one parameter, with what a value outside it
 /// most likely is and what to give instead.
 struct UsualRange {
@@ -96,7 +92,7 @@ constexpr UsualRange porosity_range{
 std::string rescaled(double v, const UsualRange& r) {
   static constexpr double factors[] = {1e3, 1e6, 1e-3, 1e-6};
   for (double f : factors)
-    if (const double w = v * f; w >= r.lo && w <= r.hi) return fmt(w);
+    if (const double w = v * f; w >= r.lo && w <= r.hi) return format4(w);
   return {};
 }
 
@@ -104,10 +100,10 @@ void check_range(double v, const UsualRange& r, const Location& where,
                  std::vector<ProblemIssue>& out) {
   if (!(v < r.lo || v > r.hi)) return;
   const bool low = v < r.lo;
-  std::string message = "is " + fmt(v) + (r.unit[0] ? std::string(" ") + r.unit : "") + ", far " +
-                        (low ? "below" : "above") + " the usual range of soils and rocks (" +
-                        r.range_text + "): " + (low ? r.below : r.above) +
-                        ". What to change: check the value and its unit";
+  std::string message =
+      "is " + format4(v) + (r.unit[0] ? std::string(" ") + r.unit : "") + ", far " +
+      (low ? "below" : "above") + " the usual range of soils and rocks (" + r.range_text +
+      "): " + (low ? r.below : r.above) + ". What to change: check the value and its unit";
   const std::string fix = rescaled(v, r);
   if (!fix.empty()) message += " (e.g. " + fix + " " + r.unit + ")";
   message += "; if the value is deliberate (a non-dimensional benchmark), ignore this warning";
@@ -148,7 +144,7 @@ void check_strength(const Material& m, const Location& w, std::vector<ProblemIss
   if (!s.plastic) return;
   if (s.phi > max_friction_deg)
     out.push_back({w / "friction_angle",
-                   "is " + fmt(s.phi) +
+                   "is " + format4(s.phi) +
                        " degrees, above the friction angle of soils and rock joints (about 25 to "
                        "45 degrees; 50 at most for dense angular gravel): the material would be "
                        "unrealistically strong, and its dilatancy bound is as high. What to "
@@ -157,19 +153,19 @@ void check_strength(const Material& m, const Location& w, std::vector<ProblemIss
   else if (s.phi > 0 && s.phi < 1.6)
     out.push_back(
         {w / "friction_angle",
-         "is " + fmt(s.phi) + " degrees: likely an angle in radians (" + fmt(s.phi) + " rad is " +
-             fmt(s.phi * 180.0 / std::numbers::pi) +
+         "is " + format4(s.phi) + " degrees: likely an angle in radians (" + format4(s.phi) +
+             " rad is " + format4(s.phi * 180.0 / std::numbers::pi) +
              " degrees). What to change: give friction_angle in degrees (usually 20 to 45)"});
   if (s.c > 0 && s.c < min_cohesion)
     out.push_back({w / "cohesion",
-                   "is " + fmt(s.c) +
+                   "is " + format4(s.c) +
                        " Pa, far below any soil's cohesion worth modelling (0, or 1 kPa to 200 "
                        "kPa for soils, up to tens of MPa for rock masses): likely kPa given as "
                        "Pa. What to change: give cohesion in Pa (10 kPa is 1e4), or 0 for a "
                        "cohesionless soil"});
   if (s.c > max_cohesion)
     out.push_back({w / "cohesion",
-                   "is " + fmt(s.c) +
+                   "is " + format4(s.c) +
                        " Pa, above the cohesion of intact strong rock (soils 0 to 200 kPa, rock "
                        "masses up to tens of MPa): likely a value in kPa given in Pa twice over. "
                        "What to change: give cohesion in Pa (50 kPa is 5e4)"});
@@ -188,11 +184,11 @@ void check_poisson(const Material& m, const Location& w, std::vector<ProblemIssu
               "number of explicit steps grow without bound and linear elements lock. What to "
               "change: 0.45 or less, or model the water with 'hydraulic' and a drained "
               "Poisson's ratio (0.2 to 0.35)";
-    out.push_back(
-        {w / "poisson_ratio", "is " + fmt(nu) + " (at most " + fmt(max_nu) + " is usual): " + why});
+    out.push_back({w / "poisson_ratio",
+                   "is " + format4(nu) + " (at most " + format4(max_nu) + " is usual): " + why});
   } else if (nu < 0) {
     out.push_back({w / "poisson_ratio",
-                   "is " + fmt(nu) +
+                   "is " + format4(nu) +
                        ": soils and rocks have Poisson's ratios between 0 and 0.5 (0.1 to 0.4 "
                        "drained). What to change: check the sign, e.g. 0.3"});
   }
@@ -385,19 +381,19 @@ void check_slopes(const Problem& p, const std::vector<BodyLayout>& layouts,
       // Appended piece by piece: GCC 12 warns (-Wrestrict, a false positive)
       // on "(" + std::string here.
       where.assign(1, '(');
-      where.append(fmt(f.a[0])).append(", ").append(fmt(f.a[1])).append(") to (");
-      where.append(fmt(f.b[0])).append(", ").append(fmt(f.b[1])).append(")");
+      where.append(format4(f.a[0])).append(", ").append(format4(f.a[1])).append(") to (");
+      where.append(format4(f.b[0])).append(", ").append(format4(f.b[1])).append(")");
     }
     if (steepest < 0) continue;
     out.push_back(
         {Location{"bodies"} / b,
-         "has a free face from " + where + " inclined " + fmt(steepest) +
+         "has a free face from " + where + " inclined " + format4(steepest) +
              " degrees to the horizontal (across gravity), steeper than the friction angle " +
-             fmt(s.phi) + " degrees of its cohesionless material '" + m.name +
+             format4(s.phi) + " degrees of its cohesionless material '" + m.name +
              "': a cohesionless slope stands at most at its friction angle (infinite-slope "
              "limit tan(beta) = tan(phi), dry), so this face will run out under gravity. What to "
              "change: nothing if the collapse is the point; else flatten the face to at most " +
-             fmt(s.phi) +
+             format4(s.phi) +
              " degrees, give the material cohesion, or support the face (a boundary or a "
              "traction)"});
   }
@@ -477,9 +473,9 @@ void check_bearing(const Problem& p, const std::vector<BodyLayout>& layouts,
       if (!velocity_prescribed(p, side_node, h)) continue;
       width *= 2;
       free_gap = gap_lo < tol ? gap_hi : gap_lo;
-      symmetry = " (twice the loaded " + fmt(width / 2) +
+      symmetry = " (twice the loaded " + format4(width / 2) +
                  " m: a half footing on the symmetry plane " + std::string(h == 0 ? "x" : "y") +
-                 " = " + fmt(side_node[h]) + ")";
+                 " = " + format4(side_node[h]) + ")";
     } else {
       free_gap = std::min(gap_lo, gap_hi);
     }
@@ -494,17 +490,17 @@ void check_bearing(const Problem& p, const std::vector<BodyLayout>& layouts,
     if (!(peak > q_ult)) continue;
     out.push_back(
         {Location{"tractions"} / k,
-         "presses with up to " + fmt(peak) + " Pa" + (varying ? " on average" : "") +
-             " on a strip of width " + fmt(width) + " m" + symmetry + " on top of body " +
+         "presses with up to " + format4(peak) + " Pa" + (varying ? " on average" : "") +
+             " on a strip of width " + format4(width) + " m" + symmetry + " on top of body " +
              std::to_string(body) + " ('" + m.name +
              "'), above its drained strip bearing capacity q_ult = c Nc + gamma' B N_gamma / 2 = " +
-             fmt(q_ult) + " Pa (Prandtl/Terzaghi surface footing, Vesic's N_gamma; c = " +
-             fmt(s.c) + " Pa, phi = " + fmt(s.phi) + " degrees, " +
-             (m.hydraulic ? "buoyant " : "") + "unit weight " + fmt(gamma) +
+             format4(q_ult) + " Pa (Prandtl/Terzaghi surface footing, Vesic's N_gamma; c = " +
+             format4(s.c) + " Pa, phi = " + format4(s.phi) + " degrees, " +
+             (m.hydraulic ? "buoyant " : "") + "unit weight " + format4(gamma) +
              " N/m3): the ground under the load will fail and a load-controlled footing will "
              "punch in until the run fails or runs out (a fast load on saturated soil may stand "
              "for a while on negative pore pressure). What to change: a load below " +
-             fmt(q_ult) +
+             format4(q_ult) +
              " Pa, a wider strip or a stronger material; or prescribe the footing's velocity "
              "(displacement control) to find the failure load"});
   }

@@ -352,14 +352,6 @@ StableStep stable_step(const Problem& problem) {
 
 // ---------------------------------------------------------------- checks
 
-namespace {
-
-std::string fmt(double v) {
-  return format_significant(v, 4);
-}
-
-}  // namespace
-
 /// A polygon must have 3 or more vertices, no repeated vertex, non-zero
 /// area and no crossing or touching edges.
 void check_polygon(const Polygon& polygon, const Location& w, std::vector<ProblemIssue>& issues) {
@@ -416,8 +408,8 @@ std::string grid_range(const Problem& problem) {
   std::string out;
   const char* names[] = {"x", "y", "z"};
   for (int a = 0; a < problem.dimension; ++a)
-    out += std::string(a ? ", " : "") + names[a] + " in [" + fmt(problem.grid.min[a]) + ", " +
-           fmt(problem.grid.max[a]) + "]";
+    out += std::string(a ? ", " : "") + names[a] + " in [" + format4(problem.grid.min[a]) + ", " +
+           format4(problem.grid.max[a]) + "]";
   return out;
 }
 
@@ -491,8 +483,9 @@ void check_body_shape(const Problem& problem, const Body& body, const Location& 
     }
     if (pr.axis < 0 || pr.axis > 2) issues.push_back({w / "prism" / "axis", "must be x, y or z"});
     if (!(pr.to > pr.from))
-      issues.push_back({w / "prism" / "to",
-                        "is " + fmt(pr.to) + "; must be greater than from (" + fmt(pr.from) + ")"});
+      issues.push_back(
+          {w / "prism" / "to",
+           "is " + format4(pr.to) + "; must be greater than from (" + format4(pr.from) + ")"});
     check_polygon(pr.polygon, w / "prism" / "polygon", issues);
   }
   if (body.points) {
@@ -510,7 +503,7 @@ void check_body_shape(const Problem& problem, const Body& body, const Location& 
     int reported = 0;  // the first few of a long list say enough
     for (std::size_t k = 0; k < pl.volumes.size() && reported < 10; ++k)
       if (!(pl.volumes[k] > 0 && std::isfinite(pl.volumes[k]))) {
-        issues.push_back({wp / "volumes" / k, "is " + fmt(pl.volumes[k]) +
+        issues.push_back({wp / "volumes" / k, "is " + format4(pl.volumes[k]) +
                                                   "; a particle volume must be > 0 (m^3 in 3D, "
                                                   "m^2 per metre in 2D, m in 1D)"});
         ++reported;
@@ -555,7 +548,8 @@ std::string darcy_growth_advice(const Material& m, const MaterialConstants& c) {
     out =
         "no fluid_bulk_modulus up to water's 2.2e9 Pa removes it (the skeleton is stiffer "
         "than the fluid's storage allows); a softer skeleton (youngs_modulus at most " +
-        format_upper_bound(e_target) + " Pa, if " + fmt(m.youngs_modulus) + " Pa is a unit slip), ";
+        format_upper_bound(e_target) + " Pa, if " + format4(m.youngs_modulus) +
+        " Pa is a unit slip), ";
   return out + "local_damping for quasi-static runs, or darcy_inertia: false (drops the term)";
 }
 
@@ -571,14 +565,14 @@ std::vector<ProblemIssue> problem_warnings(const Problem& problem) {
     if (growth <= 0.9) continue;
     const std::string what =
         std::isinf(growth)
-            ? "the grains are not denser than the fluid (density " + fmt(m.density) +
-                  " kg/m3, fluid " + fmt(c.fluid_density) +
+            ? "the grains are not denser than the fluid (density " + format4(m.density) +
+                  " kg/m3, fluid " + format4(c.fluid_density) +
                   "), so the u-p equations with the rho_f a term of Darcy's law have growing "
                   "solutions for any stiffness: oscillations can grow and the run can diverge. "
                   "What to change: check density (the grain density, not the mixture's), or "
                   "set darcy_inertia: false (drops the term)"
-            : "constrained modulus x storage (E_oed Q = " + fmt(c.constrained_modulus * c.storage) +
-                  ") is " + fmt(growth) +
+            : "constrained modulus x storage (E_oed Q = " +
+                  format4(c.constrained_modulus * c.storage) + ") is " + format4(growth) +
                   " times (rho - rho_f)/rho_f, above which the u-p equations with the rho_f a "
                   "term of Darcy's law have growing solutions (near it, waves hardly decay): "
                   "oscillations can grow and the run can diverge. What to change: " +
@@ -698,9 +692,9 @@ void check_consolidation(const Problem& problem, std::vector<ProblemIssue>& issu
   }
   const double end = problem.stages.empty() ? problem.time.end : problem.stages.back().end;
   if (!(c.from >= 0 && c.from < end))
-    issues.push_back({w / "from", "is " + fmt(c.from) + " s; it must be in [0, " + fmt(end) +
-                                      ") s, inside the run (the job ends at t = " + fmt(end) +
-                                      " s)"});
+    issues.push_back(
+        {w / "from", "is " + format4(c.from) + " s; it must be in [0, " + format4(end) +
+                         ") s, inside the run (the job ends at t = " + format4(end) + " s)"});
   if (c.all) return;
   std::int64_t held = 0;
   const std::vector<BodyLayout> layouts = body_layouts(problem);

@@ -55,9 +55,12 @@ json column_spec(const Column& c) {
   spec["name"] = "consolidation-under-gravity";
   spec["dimension"] = 1;
   spec["grid"] = {{"min", one(0.0)}, {"max", one(c.H + 2 * h)}, {"cells", one(c.cells + 2)}};
-  json hydraulic = {{"porosity", c.n}, {"hydraulic_conductivity", c.k}, {"fluid_bulk_modulus", c.kw}};
-  spec["materials"]["clay"] = {{"model", "linear_elastic"}, {"density", 2650.0},
-                               {"youngs_modulus", c.E},     {"poisson_ratio", c.nu},
+  json hydraulic = {
+      {"porosity", c.n}, {"hydraulic_conductivity", c.k}, {"fluid_bulk_modulus", c.kw}};
+  spec["materials"]["clay"] = {{"model", "linear_elastic"},
+                               {"density", 2650.0},
+                               {"youngs_modulus", c.E},
+                               {"poisson_ratio", c.nu},
                                {"hydraulic", hydraulic}};
   json body = {{"material", "clay"},
                {"box", {{"min", one(0.0)}, {"max", one(c.H)}}},
@@ -73,9 +76,10 @@ json column_spec(const Column& c) {
                {"face", "x+"},
                {"traction", one(-c.q)}};
   spec["tractions"] = json::array({load});
-  spec["time"] = {{"end", c.time_of(1.0)},
-                  {"scheme", "quasi_static"},
-                  {"dt", {{"initial", c.time_of(1e-4)}, {"max", c.time_of(1e-3)}, {"growth", 1.2}}}};
+  spec["time"] = {
+      {"end", c.time_of(1.0)},
+      {"scheme", "quasi_static"},
+      {"dt", {{"initial", c.time_of(1e-4)}, {"max", c.time_of(1e-3)}, {"growth", 1.2}}}};
   spec["output"]["consolidation"] = {{"interval", c.time_of(0.01)}, {"from", c.time_of(1e-4)}};
   return spec;
 }
@@ -180,8 +184,7 @@ TEST(Consolidation, MistakesAreReportedAtTheirPaths) {
   EXPECT_NE(issue_at(spec, "/output/consolidation/interval"), "");
   spec = column_spec(c);
   spec["output"]["consolidation"]["from"] = c.time_of(2.0);
-  EXPECT_NE(issue_at(spec, "/output/consolidation/from").find("inside the run"),
-            std::string::npos);
+  EXPECT_NE(issue_at(spec, "/output/consolidation/from").find("inside the run"), std::string::npos);
   spec = column_spec(c);
   spec["output"]["consolidation"]["particles"] = {
       {"box", {{"min", one(c.H + 0.05)}, {"max", one(c.H + 0.1)}}}};

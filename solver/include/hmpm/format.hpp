@@ -59,6 +59,11 @@ inline std::string format_significant(double v, int digits) {
   return o.str();
 }
 
+/// Four significant digits: the numbers of messages.
+inline std::string format4(double v) {
+  return format_significant(v, 4);
+}
+
 /// A positive bound printed to 4 significant digits without exceeding it
 /// ("use dt <= X": X itself must pass the check): the value lowered by half
 /// a unit in the 4th digit, then rounded, is at most v.
