@@ -28,8 +28,9 @@ pairs=${PAIRS:-9}
 build=${BUILD_DIR:-build-bench}
 
 cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=Release -DHMPM_BUILD_TESTS=OFF >/dev/null
-cmake --build "$build" --target bench_mpm -j"$(nproc)" >/dev/null
+cmake --build "$build" --target bench_mpm reference_kernel -j"$(nproc)" >/dev/null
 bench="$build/bin/bench_mpm"
+reference="$build/bin/reference_kernel"
 
 # Side lengths in cells giving about 10k, 100k, 400k and 1M particles at 2
 # particles per cell per axis (2D: 4 per cell, 3D: 8 per cell).
@@ -45,6 +46,23 @@ fi
 
 value() { sed -n "s/.* $1=\([^ ]*\).*/\1/p"; }
 
+# The reference kernel's throughput (best of $repeat) for a dimension and
+# block size, measured once per script run: bench/reference_kernel.cpp, a
+# plain USL MPM of the same dry problem (issue 21's yardstick).
+declare -A reference_ps
+reference_for() {
+  local dim=$1 nb=$2 steps=$3 key="$1/$2"
+  if [[ -z ${reference_ps[$key]:-} ]]; then
+    local best=0 ps r
+    for ((r = 0; r < repeat; ++r)); do
+      ps=$("$reference" --dim "$dim" --nb "$nb" --steps "$steps" | value particle_steps_per_second)
+      best=$(awk -v a="$ps" -v b="$best" 'BEGIN{print (a > b) ? a : b}')
+    done
+    reference_ps[$key]=$best
+  fi
+  reference_value=${reference_ps[$key]}  # a global: $(...) would lose the cache
+}
+
 # One row: best throughput over $repeat runs of bench_mpm with these flags.
 row() {
   local label=$1
@@ -59,13 +77,19 @@ row() {
       line=$out
     fi
   done
-  local particles threads state rss
+  local particles threads state rss dim nb steps ref
+  dim=$(value dim <<<" $line")
+  nb=$(value nb <<<"$line")
+  steps=$(value steps <<<"$line")
+  reference_for "$dim" "$nb" "$steps"
+  ref=$reference_value
   particles=$(value particles <<<"$line")
   threads=$(value threads <<<"$line")
   state=$(value state_bytes_per_particle <<<"$line")
   rss=$(value peak_rss_bytes_per_particle <<<"$line")
-  printf '| %s | %s | %s | %.2f M | %.0f | %.0f |\n' "$label" "$particles" "$threads" \
-    "$(awk -v v="$best" 'BEGIN{print v / 1e6}')" "$state" "$rss"
+  printf '| %s | %s | %s | %.2f M | %.2f× | %.0f | %.0f |\n' "$label" "$particles" "$threads" \
+    "$(awk -v v="$best" 'BEGIN{print v / 1e6}')" "$(awk -v a="$best" -v b="$ref" 'BEGIN{print a / b}')" \
+    "$state" "$rss"
 }
 
 steps_for() {  # particles-per-cell^dim * nb^dim -> steps for ~$work particle-steps
@@ -76,8 +100,8 @@ steps_for() {  # particles-per-cell^dim * nb^dim -> steps for ~$work particle-st
 }
 
 table() {
-  echo '| case | particles | threads | particle-steps/s | state B/particle | peak RSS B/particle |'
-  echo '|---|---:|---:|---:|---:|---:|'
+  echo '| case | particles | threads | particle-steps/s | ÷ reference kernel | state B/particle | peak RSS B/particle |'
+  echo '|---|---:|---:|---:|---:|---:|---:|'
   local nb n
   for coupled in "" "--coupled"; do
     local kind=dry
@@ -160,10 +184,26 @@ machine() {
   echo "- Command: \`bash bench/run.sh\` (best of $repeat runs per row; the time loop only, as in summary.json)"
 }
 
+reference_table() {
+  echo '| reference kernel (bench/reference_kernel.cpp) | particles | particle-steps/s |'
+  echo '|---|---:|---:|'
+  local key
+  for key in $(printf '%s\n' "${!reference_ps[@]}" | sort -t/ -k1,1n -k2,2n); do
+    local dim=${key%/*} nb=${key#*/}
+    printf '| %sD dry linear, USL | %s | %.2f M |\n' "$dim" "$(( (2 * nb) ** dim ))" \
+      "$(awk -v v="${reference_ps[$key]}" 'BEGIN{print v / 1e6}')"
+  done
+}
+
 result=$(
   machine
   echo
   table
+  echo
+  echo "Each row's throughput divided by the reference kernel's on the same dimension and block size,"
+  echo "run in this script (best of $repeat):"
+  echo
+  reference_table
   echo
   echo "Two threads (alternating runs, $pairs pairs per row):"
   echo
