@@ -236,8 +236,7 @@ int run(int nb, int steps) {
       "dim=%d nb=%d particles=%ld steps=%d particle_steps_per_second=%.4g "
       "top_settlement=%.6g\n",
       Dim, nb, k.particles(), steps,
-      static_cast<double>(k.particles()) * steps / std::max(seconds, 1e-9),
-      k.top_settlement(nb));
+      static_cast<double>(k.particles()) * steps / std::max(seconds, 1e-9), k.top_settlement(nb));
   return 0;
 }
 
