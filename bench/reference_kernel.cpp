@@ -47,7 +47,7 @@ struct Kernel {
   std::array<std::vector<double>, Dim> momentum, force;
   double lambda = 0, mu = 0, gravity = -9.81;
 
-  Kernel(int nb, double h_, double dt_) : h(h_), inv_h(1.0 / h_), dt(dt_) {
+  Kernel(int nb, double cell, double step_length) : h(cell), inv_h(1.0 / cell), dt(step_length) {
     for (int a = 0; a < Dim; ++a) cells[a] = a == up ? nb + 2 : nb;
     int n = 1;
     for (int a = 0; a < Dim; ++a) {
