@@ -655,7 +655,11 @@ void check_stages(const Problem& problem, std::vector<ProblemIssue>& issues) {
              (key == "fluxes" && st.fluxes) || (key == "time" && st.time) ||
              (key == "gravity" && st.gravity) || (key == "local_damping" && st.local_damping);
     };
-    for (const ProblemIssue& issue : check_problem(stage_problem(problem, i + 1))) {
+    Problem in_force = stage_problem(problem, i + 1);
+    // output.consolidation is the job's (its `from` may lie in a later
+    // stage): checked once, with the whole job.
+    in_force.output.consolidation = ConsolidationRequest{};
+    for (const ProblemIssue& issue : check_problem(in_force)) {
       const std::string text = issue.where.text() + ": " + issue.message;
       if (std::find(top.begin(), top.end(), text) != top.end()) continue;
       const std::string& key = issue.where.parts.empty() ? std::string() : issue.where.parts[0];

@@ -25,18 +25,15 @@ value). Checked:
 The settlement is the integral of the prescribed velocity (the spec's
 formula, evaluated here).
 """
-import json
 import math
-import os
 import sys
+
+import example_results
 
 
 def main():
-    example, results = sys.argv[1:3]
-    with open(example) as f:
-        spec = json.load(f)
-    with open(os.path.join(results, "reactions.json")) as f:
-        reactions = json.load(f)
+    spec, _, read = example_results.load()
+    reactions = read("reactions.json")
     clay = spec["materials"]["clay"]
     c_u = clay["cohesion"]
     assert clay["friction_angle"] == 0.0, "the check is Prandtl's Tresca solution"

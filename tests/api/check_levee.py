@@ -50,9 +50,9 @@ Checked:
   interpolation near the face weighs more): the face holds p = 0;
 - the run is successful, in 2 stages.
 """
-import json
-import os
 import sys
+
+import example_results
 
 GAMMA_W = 9810.0
 
@@ -88,13 +88,8 @@ def blanket_theory(h, length, toe_river, toe_land, k_a, thickness, k_b, z_b, gro
 
 
 def main():
-    example, out = sys.argv[1:3]
-    with open(example) as f:
-        spec = json.load(f)
-    with open(os.path.join(out, "profiles.json")) as f:
-        profiles = json.load(f)
-    with open(os.path.join(out, "summary.json")) as f:
-        summary = json.load(f)
+    spec, _, read = example_results.load()
+    profiles, summary = read("profiles.json"), read("summary.json")
     problems = []
     if summary["status"] != "successful" or "in 2 stages" not in summary["message"]:
         problems.append(f"the run: {summary['status']}: {summary['message']}")

@@ -18,20 +18,14 @@ Checked:
    rises and the floor heaves, both monotonically (suction dissipating; a
    sign error in the removal or the drainage would reverse them).
 """
-import json
-import math
-import os
 import sys
+
+import example_results
 
 
 def main():
-    example, results = sys.argv[1:3]
-    with open(example) as f:
-        spec = json.load(f)
-    with open(os.path.join(results, "series.json")) as f:
-        series = json.load(f)
-    with open(os.path.join(results, "reactions.json")) as f:
-        reactions = json.load(f)
+    spec, _, read = example_results.load()
+    series, reactions = read("series.json"), read("reactions.json")
     g = -spec["gravity"][1]
     clay = spec["materials"]["clay"]
     n = clay["hydraulic"]["porosity"]

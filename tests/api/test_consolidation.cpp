@@ -201,6 +201,26 @@ TEST(Consolidation, MistakesAreReportedAtTheirPaths) {
   EXPECT_NE(issue_at(spec, "/output/consolidation").find("needs pore water"), std::string::npos);
 }
 
+// In a job of several stages `from` may lie in any stage: it is checked
+// against the job's end, not against the end of each stage in force.
+TEST(Consolidation, FromInALaterStageOfAStagedJobIsAccepted) {
+  const Column c;
+  json spec = column_spec(c);
+  const double end = c.time_of(1.0);
+  spec["time"]["end"] = end / 4;
+  spec["stages"] = json::array(
+      {json{{"name", "second"}, {"end", end / 2}}, json{{"name", "third"}, {"end", end}}});
+  spec["output"]["consolidation"]["from"] = 0.75 * end;
+  EXPECT_EQ(issue_at(spec, "/output/consolidation/from"), "");
+  EXPECT_EQ(issue_at(spec, "/stages/0"), "");
+  const ParseResult r = parse_job(spec.dump());
+  for (const SpecError& e : r.errors) ADD_FAILURE() << e.path << ": " << e.message;
+  // Past the job's end it is still refused, once, at its path.
+  spec["output"]["consolidation"]["from"] = 1.5 * end;
+  EXPECT_NE(issue_at(spec, "/output/consolidation/from").find("inside the run"), std::string::npos);
+  EXPECT_EQ(issue_at(spec, "/stages/0"), "");
+}
+
 // Gravity on the pore water and no water table to take the hydrostatic
 // pressure from: a warning whose advice gives the formula to write.
 TEST(Consolidation, NoSteadyPressureUnderGravityWarnsWithTheFormula) {
