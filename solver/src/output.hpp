@@ -141,14 +141,9 @@ void Simulation<Dim, Shape>::sample_consolidation(RunResult::Consolidation& c,
                                                   double t) const {
   const FieldOfPosition& steady = job_.output.consolidation.steady_pore_pressure;
   double excess = 0.0, volume = 0.0;
-  for (std::int64_t pi : counted) {
-    // A staged job numbers particles as the job does; one out of the run
-    // (a body not added yet, or removed) does not count.
-    const std::int64_t slot = slot_.empty() ? pi : slot_[static_cast<std::size_t>(pi)];
-    if (slot < 0) continue;
-    const auto p = static_cast<std::size_t>(slot);
+  auto add = [&](std::size_t p) {
     const MaterialConstants& m = constants_[particles_.material[p]];
-    if (!m.saturated || particles_.pressure_out.empty()) continue;
+    if (!m.saturated || particles_.pressure_out.empty()) return;
     const double v0 = particles_.mass[p] / m.mixture_density;
     double ps = 0.0;
     if (steady) {
@@ -158,6 +153,16 @@ void Simulation<Dim, Shape>::sample_consolidation(RunResult::Consolidation& c,
     }
     excess += (particles_.pressure_out[p] - ps) * v0;
     volume += v0;
+  };
+  if (job_.output.consolidation.all) {
+    for (std::size_t p = 0; p < particles_.size(); ++p) add(p);  // those in the run
+  } else {
+    for (std::int64_t pi : counted) {
+      // A staged job numbers particles as the job does; one out of the run
+      // (a body not added yet, or removed) does not count.
+      const std::int64_t slot = slot_.empty() ? pi : slot_[static_cast<std::size_t>(pi)];
+      if (slot >= 0) add(static_cast<std::size_t>(slot));
+    }
   }
   c.time.push_back(t);
   c.excess.push_back(excess);

@@ -262,8 +262,9 @@ class Simulation {
   // ------------------------------------------------------------ output (output.hpp)
   void fill_snapshot(Snapshot& snap, const std::vector<Field>& fields) const;
   void sample_series(Series& series, double t) const;
-  /// Appends the excess pore pressure of `counted` (job particle indices)
-  /// at time t to `c` (OutputRequest::consolidation).
+  /// Appends the excess pore pressure at time t to `c`
+  /// (OutputRequest::consolidation): of every particle in the run when the
+  /// request counts all, else of `counted` (job particle indices).
   void sample_consolidation(RunResult::Consolidation& c, const std::vector<std::int64_t>& counted,
                             double t) const;
 

@@ -121,13 +121,13 @@ RunResult Simulation<Dim, Shape>::run(const RunOptions& options) {
       start_series(profiles[l], out.profiles[l].particles, out.profiles[l].fields);
   }
   double next_profile = out.profile_interval;
-  // Consolidation: the excess of the counted particles (job indices) at
-  // `from`, then every interval after it.
+  // Consolidation: the excess of the counted particles (job indices; none
+  // listed: every particle in the run) at `from`, then every interval after it.
   const ConsolidationRequest& cr = out.consolidation;
   RunResult::Consolidation& consolidation = result.consolidation;
   const bool want_consolidation = cr.interval > 0;
   std::vector<std::int64_t> counted;
-  if (want_consolidation) {
+  if (want_consolidation && !cr.all) {
     const std::vector<Vec3> x0 = initial_positions(job_);
     for (std::size_t pi = 0; pi < x0.size(); ++pi)
       if (particle_selected(job_, cr, x0[pi])) counted.push_back(static_cast<std::int64_t>(pi));

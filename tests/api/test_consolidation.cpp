@@ -131,6 +131,39 @@ TEST(Consolidation, SuddenLoadUnderGravityIsTerzaghisDegreeFromHydrostatic) {
   EXPECT_NEAR(b.run.consolidation.t50 / fine.time_of(1.0), 0.196731, 0.196731 * 0.025);
 }
 
+// A selection counts only its particles: one holding the whole column
+// gives what counting every particle gives, bit for bit; the lower half,
+// next to the drained base, drains first (its U runs ahead of the
+// column's, and the upper half's behind).
+TEST(Consolidation, ASelectionCountsOnlyItsParticles) {
+  Column c;
+  c.cells = 20;
+  auto run_with = [&](const json& particles) {
+    json spec = column_spec(c);
+    if (!particles.is_null()) spec["output"]["consolidation"]["particles"] = particles;
+    const ParseResult r = parse_job(spec.dump());
+    EXPECT_TRUE(r.job.has_value());
+    return r.job ? hmpm::run(r.job->problem).consolidation : RunResult::Consolidation{};
+  };
+  auto box = [](double lo, double hi) {
+    return json{{"box", {{"min", one(lo)}, {"max", one(hi)}}}};
+  };
+  const RunResult::Consolidation all = run_with(json());
+  const RunResult::Consolidation whole = run_with(box(0.0, c.H));
+  const RunResult::Consolidation lower = run_with(box(0.0, c.H / 2));
+  const RunResult::Consolidation upper = run_with(box(c.H / 2, c.H));
+  ASSERT_EQ(all.time.size(), 100u);
+  EXPECT_EQ(whole.excess, all.excess);
+  EXPECT_EQ(whole.degree, all.degree);
+  ASSERT_EQ(lower.degree.size(), all.degree.size());
+  ASSERT_EQ(upper.degree.size(), all.degree.size());
+  EXPECT_NEAR(lower.volume.front() + upper.volume.front(), all.volume.front(),
+              1e-12 * all.volume.front());
+  const std::size_t k = 10;  // T_v = 0.1
+  EXPECT_GT(lower.degree[k], all.degree[k] + 0.05);
+  EXPECT_LT(upper.degree[k], all.degree[k] - 0.05);
+}
+
 // A load applied at t = 0 has no excess yet at t = 0: U is undefined, and
 // the warning says to move `from` to the end of the loading; following it
 // (the test above) defines U.
