@@ -164,10 +164,15 @@ inline void apply_tractions(const std::vector<TractionLoad>& tractions,
 }
 
 /// Water across the faces at time t into the nodal flux (the right-hand
-/// side of s_i dp_i/dt): N area rate, positive into the soil.
-template <int Dim, class Shape, bool DeadLoad = false>
+/// side of s_i dp_i/dt): N area rate, positive into the soil. Only nodes
+/// the scheme solves the mass balance at take water (`takes(node)`: the
+/// nodes the saturated particles reach); a face that has moved into a cell
+/// the soil does not reach (a swelling top, above its last node row) gives
+/// those nodes' shares to the others of its stencil, so that all the water
+/// enters. Where every node takes water the weights are used as they are.
+template <int Dim, class Shape, bool DeadLoad = false, class Takes>
 inline void apply_fluxes(const std::vector<FluxLoad>& fluxes, const ParticleState<Dim>& particles,
-                         GridState<Dim>& grid, double t) {
+                         GridState<Dim>& grid, double t, Takes&& takes) {
   shape::Stencil<Dim, Shape> s;
   for (const FluxLoad& load : fluxes) {
     const FieldOfSpaceTime& rate = load.source->rate;
@@ -175,10 +180,18 @@ inline void apply_fluxes(const std::vector<FluxLoad>& fluxes, const ParticleStat
     const double uniform = load.x0.empty() ? rate(Vec3{0.0, 0.0, 0.0}, t) : 0.0;
     for (std::size_t k = 0; k < load.particles.size(); ++k) {
       const double r = load.x0.empty() ? uniform : rate(load.x0[k], t);
+      double all = 0.0, kept = 0.0;
       for_face_nodes<Dim, Shape, DeadLoad>(load, k, particles, grid, s,
                                            [&](std::int64_t node, double wa) {
-                                             grid.flux[static_cast<std::size_t>(node)] += wa * r;
+                                             all += wa;
+                                             if (takes(node)) kept += wa;
                                            });
+      if (!(kept > 0.0)) continue;      // no node of the face's stencil holds water
+      const double scale = all / kept;  // exactly 1 when every node takes water
+      for_face_nodes<Dim, Shape, DeadLoad>(
+          load, k, particles, grid, s, [&](std::int64_t node, double wa) {
+            if (takes(node)) grid.flux[static_cast<std::size_t>(node)] += wa * scale * r;
+          });
     }
   }
 }

@@ -82,7 +82,9 @@ inline void Simulation<Dim, Shape>::apply_surface_loads(double t) {
 
 template <int Dim, class Shape>
 inline void Simulation<Dim, Shape>::apply_boundary_fluxes(double t) {
-  apply_fluxes<Dim, Shape>(fluxes_, particles_, grid_, t);
+  // The nodes with storage: those the saturated particles reach.
+  apply_fluxes<Dim, Shape>(fluxes_, particles_, grid_, t,
+                           [this](std::int64_t i) { return grid_.storage[i] > 0.0; });
 }
 
 }  // namespace hmpm

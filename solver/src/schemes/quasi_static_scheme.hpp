@@ -227,6 +227,7 @@ class QuasiStaticScheme final : public TimeScheme {
       keys_[p] = {s.node[0], static_cast<std::int64_t>(p)};
     }
     const double tiny = 1e-12 * vmax;
+    tiny_ = tiny;
     for (std::size_t i = 0; i < nodes; ++i)
       pn_[i] = weight_fluid_[i] > tiny ? pn_[i] / weight_fluid_[i] : 0.0;
     // Degrees of freedom: prescribed components, then rigid ties, then free.
@@ -372,7 +373,10 @@ class QuasiStaticScheme final : public TimeScheme {
     // Water across faces at t + h (backward Euler), on the initial face areas.
     if (!sim_.fluxes_.empty()) {
       std::fill(grid.flux.begin(), grid.flux.end(), 0.0);
-      apply_fluxes<Dim, Shape, /*DeadLoad=*/true>(sim_.fluxes_, sim_.particles_, grid, t + h);
+      // The nodes the saturated particles reach (free or prescribed).
+      apply_fluxes<Dim, Shape, /*DeadLoad=*/true>(
+          sim_.fluxes_, sim_.particles_, grid, t + h,
+          [this](std::int64_t i) { return weight_fluid_[static_cast<std::size_t>(i)] > tiny_; });
     }
     const ImplicitControl& c = sim_.problem_.time.implicit;
     history_.resize(static_cast<std::size_t>(c.max_iterations) + 1);  // no-op after the first
@@ -781,6 +785,8 @@ class QuasiStaticScheme final : public TimeScheme {
   StepGrowth growth_;
   double nominal_ = 0.0;
   double e_ref_ = 0.0;
+  /// prepare(): a node's summed particle weight below this counts as none.
+  double tiny_ = 0.0;
   bool prepared_ = false;
   std::vector<std::int64_t> seepage_;  ///< seepage face nodes
   std::vector<std::uint8_t> held_;     ///< per node: a face node held at p = 0 this step
