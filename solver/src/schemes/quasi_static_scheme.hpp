@@ -226,10 +226,9 @@ class QuasiStaticScheme final : public TimeScheme {
       }
       keys_[p] = {s.node[0], static_cast<std::int64_t>(p)};
     }
-    const double tiny = 1e-12 * vmax;
-    tiny_ = tiny;
+    tiny_ = 1e-12 * vmax;
     for (std::size_t i = 0; i < nodes; ++i)
-      pn_[i] = weight_fluid_[i] > tiny ? pn_[i] / weight_fluid_[i] : 0.0;
+      pn_[i] = weight_fluid_[i] > tiny_ ? pn_[i] / weight_fluid_[i] : 0.0;
     // Degrees of freedom: prescribed components, then rigid ties, then free.
     udof_.assign(nodes * Dim, -1);
     pdof_.assign(nodes, -1);
@@ -245,7 +244,7 @@ class QuasiStaticScheme final : public TimeScheme {
         std::int64_t shared = -1;
         for (std::int64_t i : tie.nodes) {
           const std::size_t d = static_cast<std::size_t>(i) * Dim + a;
-          if (ufixed_[d] || !(weight_[static_cast<std::size_t>(i)] > tiny) || udof_[d] >= 0)
+          if (ufixed_[d] || !(weight_[static_cast<std::size_t>(i)] > tiny_) || udof_[d] >= 0)
             continue;
           if (shared < 0) shared = n++;
           udof_[d] = shared;
@@ -257,12 +256,12 @@ class QuasiStaticScheme final : public TimeScheme {
     for (std::int64_t i : seepage_)
       if (held_[static_cast<std::size_t>(i)]) pfixed_[static_cast<std::size_t>(i)] = 1;
     for (std::size_t i = 0; i < nodes; ++i) {
-      if (!(weight_[i] > tiny)) continue;
+      if (!(weight_[i] > tiny_)) continue;
       for (int a = 0; a < Dim; ++a) {
         const std::size_t d = i * Dim + a;
         if (!ufixed_[d] && udof_[d] < 0) udof_[d] = n++;
       }
-      if (weight_fluid_[i] > tiny && !pfixed_[i]) pdof_[i] = n++;
+      if (weight_fluid_[i] > tiny_ && !pfixed_[i]) pdof_[i] = n++;
     }
     unknowns_ = n;
     // Stabilisation cells: particles grouped by stencil anchor.
