@@ -25,6 +25,9 @@
 //   particles  every array of ParticleState::for_each_array, in its order
 //            (those of the stage in force: a resumed run first replays the
 //            stages' moves of bodies)
+//   absorbing  u64 the absorbing boundaries of the stage in force, per
+//            boundary u8 whether its forces at rest are taken and their
+//            array (boundary/constraints.hpp)
 //   scheme   TimeScheme::save (e.g. the semi-implicit solver's initial
 //            guess, the quasi-static step plan and counters)
 //   trailer  u64 FNV-1a hash of everything before it
@@ -47,8 +50,9 @@ namespace hmpm::checkpoint {
 
 inline constexpr char magic[8] = {'H', 'M', 'P', 'M', 'C', 'K', 'P', 'T'};
 /// 2: reactions; 3: plastic strain, profiles; 4: stages (the stage in
-/// force, the iterations of those before, particle ids); 5: consolidation
-inline constexpr std::uint32_t version = 5;
+/// force, the iterations of those before, particle ids); 5: consolidation;
+/// 6: absorbing boundaries' forces at rest
+inline constexpr std::uint32_t version = 6;
 
 /// FNV-1a, 64 bits, continuing from `h`.
 inline std::uint64_t fnv1a(const char* data, std::size_t n,

@@ -90,8 +90,10 @@ bool Simulation<Dim, Shape>::loads_finite_at(double t) {
   for (std::size_t i = 0; i < problem_.boundaries.size(); ++i) {
     const Boundary& b = problem_.boundaries[i];
     for (int a = 0; a < Dim; ++a)
-      if (b.velocity[a] && !check(&*b.velocity[a], Location{"boundaries"} / i / "velocity" /
-                                                       static_cast<std::size_t>(a)))
+      if (b.velocity[a] &&
+          !check(&*b.velocity[a], Location{"boundaries"} / i /
+                                      (b.from_acceleration[a] ? "acceleration" : "velocity") /
+                                      static_cast<std::size_t>(a)))
         return false;
     if (fluid_ && b.pore_pressure &&
         !check(&*b.pore_pressure, Location{"boundaries"} / i / "pore_pressure"))

@@ -285,7 +285,14 @@ bool in_grid_2d(const Problem& p, const Vec3& x) {
 /// position x.
 bool velocity_prescribed(const Problem& p, const Vec3& x, int axis) {
   return std::any_of(p.boundaries.begin(), p.boundaries.end(), [&](const Boundary& b) {
-    return b.velocity[axis].has_value() && node_selected(p, b.nodes, x);
+    return b.velocity[axis].has_value() && !b.absorbing && node_selected(p, b.nodes, x);
+  });
+}
+
+/// Whether an absorbing boundary with normal `axis` holds the node position x.
+bool absorbing_on(const Problem& p, const Vec3& x, int axis) {
+  return std::any_of(p.boundaries.begin(), p.boundaries.end(), [&](const Boundary& b) {
+    return b.absorbing && b.absorbing->normal == axis && node_selected(p, b.nodes, x);
   });
 }
 
@@ -345,7 +352,7 @@ int open_points(const Problem& p, const NearIndex& near, const Face& f, double s
     const int axis = std::abs(f.n[0]) >= std::abs(f.n[1]) ? 0 : 1;
     const int side = f.n[axis] > 0 ? 1 : -1;
     if (traction_on(p, in, axis, side)) continue;
-    if (velocity_prescribed(p, m, axis)) continue;
+    if (velocity_prescribed(p, m, axis) || absorbing_on(p, m, axis)) continue;
     if (in_grid_2d(p, out) && near.any_within(out, 0.75 * s)) continue;
     ++open;
   }

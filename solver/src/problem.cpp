@@ -454,6 +454,32 @@ void check_hydraulic_boundaries(const Problem& problem, std::vector<ProblemIssue
   }
 }
 
+void check_absorbing_boundaries(const Problem& problem, std::vector<ProblemIssue>& issues) {
+  for (std::size_t i = 0; i < problem.boundaries.size(); ++i) {
+    const Boundary& b = problem.boundaries[i];
+    if (!b.absorbing) continue;
+    const Location w = Location{"boundaries"} / i / "absorbing";
+    if (problem.time.scheme != Scheme::explicit_scheme)
+      issues.push_back({w, std::string("needs time.scheme 'explicit' (this ") +
+                               (problem.stages.empty() ? "job" : "stage") + " runs '" +
+                               scheme_name(problem.time.scheme) +
+                               "'): dashpots act on inertia, which the quasi-static scheme "
+                               "has none of, and the semi-implicit pressure system does not "
+                               "carry them yet"});
+    if (b.absorbing->normal < 0 || b.absorbing->normal >= problem.dimension)
+      issues.push_back({w / "normal", "names an axis this " + std::to_string(problem.dimension) +
+                                          "D problem does not have"});
+    if (b.absorbing->material >= problem.materials.size())
+      issues.push_back(
+          {w / "material", "is " + std::to_string(b.absorbing->material) + " but the job has " +
+                               std::to_string(problem.materials.size()) + " materials"});
+    if (b.rigid[0] || b.rigid[1] || b.rigid[2] || b.friction)
+      issues.push_back({w,
+                        "cannot share an entry with 'rigid' or 'friction': give the tie or "
+                        "wall its own boundary entry"});
+  }
+}
+
 void check_body_shape(const Problem& problem, const Body& body, const Location& w,
                       std::vector<ProblemIssue>& issues) {
   const int shapes = (body.polygon ? 1 : 0) + (body.prism ? 1 : 0) + (body.points ? 1 : 0);
@@ -555,6 +581,84 @@ std::string darcy_growth_advice(const Material& m, const MaterialConstants& c) {
 
 }  // namespace
 
+/// A boundary on a face of the grid whose velocity (prescribed, or the
+/// input motion of an absorbing base) carries the soil towards the grid's
+/// edge further than the room there: a shaken base moves the whole layer
+/// along the shaking, and particles that leave the grid stop the run. The
+/// displacement is the velocity's integral over the job's time (2000
+/// trapezoids); the room is the gap between the bodies' particles and the
+/// grid's edges along that axis. Sideways: the smaller gap of the two
+/// sides; along the face normal: the gap behind the face, when the motion
+/// moves away from the soil.
+void check_room_for_motion(const Problem& problem, const std::vector<BodyLayout>& layouts,
+                           std::vector<ProblemIssue>& warnings) {
+  const int dim = problem.dimension;
+  double end = problem.time.end;
+  for (const Stage& s : problem.stages) end = std::max(end, s.end);
+  for (std::size_t i = 0; i < problem.boundaries.size(); ++i) {
+    const Boundary& b = problem.boundaries[i];
+    if (b.nodes.all || b.nodes.polygon) continue;
+    // The grid face the nodes lie on: its normal axis and side (-1: min).
+    int normal = -1, side = 0;
+    for (int a = 0; a < dim; ++a) {
+      if (b.nodes.box.min[a] != b.nodes.box.max[a]) continue;
+      if (b.nodes.box.min[a] <= problem.grid.min[a] || b.nodes.box.max[a] >= problem.grid.max[a]) {
+        normal = a;
+        side = b.nodes.box.min[a] <= problem.grid.min[a] ? -1 : 1;
+      }
+    }
+    if (normal < 0) continue;
+    for (int a = 0; a < dim; ++a) {
+      if (!b.velocity[a]) continue;
+      constexpr int samples = 2000;
+      double u = 0.0, lowest = 0.0, highest = 0.0, v_prev = (*b.velocity[a])(0.0);
+      for (int k = 1; k <= samples; ++k) {
+        const double v = (*b.velocity[a])(end * k / samples);
+        u += 0.5 * (v + v_prev) * end / samples;
+        v_prev = v;
+        lowest = std::min(lowest, u);
+        highest = std::max(highest, u);
+      }
+      if (!std::isfinite(lowest) || !std::isfinite(highest)) continue;
+      // Room along a: between the particles (half a spacing inside the
+      // filled extent) and the grid's edges.
+      double below = std::numeric_limits<double>::infinity(), above = below;
+      const double h = (problem.grid.max[a] - problem.grid.min[a]) / problem.grid.cells[a];
+      for (std::size_t k = 0; k < layouts.size(); ++k) {
+        if (layouts[k].count == 0) continue;
+        const double half = 0.5 * h / problem.bodies[k].particles_per_cell;
+        below = std::min(below, layouts[k].lo[a] + half - problem.grid.min[a]);
+        above = std::min(above, problem.grid.max[a] - layouts[k].hi[a] + half);
+      }
+      double reach = 0.0, room = 0.0;
+      std::string where;
+      if (a != normal) {
+        reach = std::max(-lowest, highest);
+        room = std::min(below, above);
+        where = "sideways";
+      } else {
+        reach = side < 0 ? -lowest : highest;
+        room = side < 0 ? below : above;
+        where = "out of the grid across its face";
+      }
+      if (!(reach > room)) continue;
+      const std::string axis(1, static_cast<char>('x' + a));
+      warnings.push_back(
+          {Location{"boundaries"} / i / (b.from_acceleration[a] ? "acceleration" : "velocity") /
+               static_cast<std::size_t>(a),
+           "moves its nodes, and the soil with them, up to " + format4(reach) + " m along " + axis +
+               " " + where + " over the run (the integral of the velocity), more than the " +
+               format4(room) +
+               " m between the outermost particles and the grid's edge: "
+               "particles will leave the grid and the run will stop there. What to change: "
+               "extend the grid along " +
+               axis + " by at least " + format4(reach - room) +
+               " m beyond the soil (the added cells stay empty), or check the motion's "
+               "baseline (a velocity that does not return to zero drifts)"});
+    }
+  }
+}
+
 std::vector<ProblemIssue> problem_warnings(const Problem& problem) {
   std::vector<ProblemIssue> warnings;
   for (const Material& m : problem.materials) {
@@ -593,6 +697,7 @@ std::vector<ProblemIssue> problem_warnings(const Problem& problem) {
                ") so that they do not overlap, or list body " + std::to_string(b) +
                " first if the shared place should be its (body " + std::to_string(earlier) +
                " then loses it)"});
+  check_room_for_motion(problem, layouts, warnings);
   for (ProblemIssue& w : material_plausibility(problem)) warnings.push_back(std::move(w));
   for (ProblemIssue& w : stability_plausibility(problem)) warnings.push_back(std::move(w));
   for (ProblemIssue& w : geostatic_warnings(problem)) warnings.push_back(std::move(w));
@@ -807,6 +912,7 @@ std::vector<ProblemIssue> check_problem(const Problem& problem) {
               std::to_string(prescribed));
     if (!(*bc.friction >= 0)) add(w, "must be >= 0");
   }
+  check_absorbing_boundaries(problem, issues);
   check_hydraulic_boundaries(problem, issues);
   if (!(problem.time.end > 0)) add({"time", "end"}, "must be > 0");
   if (!(problem.time.courant > 0 && problem.time.courant <= 1))

@@ -226,6 +226,15 @@ RunResult Simulation<Dim, Shape>::run(const RunOptions& options) {
     if (first_stage != stage_) enter_stage(first_stage);
     particles_.for_each_array(
         [&](auto& a) { r.array(a, static_cast<std::int64_t>(a.size()), "particle array"); });
+    const auto absorbing = r.pod<std::uint64_t>();
+    if (absorbing != constraints_.absorbing.size())
+      throw std::invalid_argument("the checkpoint has " + std::to_string(absorbing) +
+                                  " absorbing boundaries where this run has " +
+                                  std::to_string(constraints_.absorbing.size()));
+    for (AbsorbingConstraint& ab : constraints_.absorbing) {
+      ab.held = r.pod<std::uint8_t>() != 0;
+      r.array(ab.hold, static_cast<std::int64_t>(ab.hold.size()), "absorbing boundary's forces");
+    }
   } else {
     if (want_series) sample_series(series, 0.0);
     for (Series& s : profiles) sample_series(s, 0.0);
@@ -287,6 +296,11 @@ RunResult Simulation<Dim, Shape>::run(const RunOptions& options) {
     w.pod(done_iterations.max_nonlinear);
     w.array(done_iterations.worst_residuals);
     particles_.for_each_array([&](const auto& a) { w.array(a); });
+    w.pod(static_cast<std::uint64_t>(constraints_.absorbing.size()));
+    for (const AbsorbingConstraint& ab : constraints_.absorbing) {
+      w.pod(static_cast<std::uint8_t>(ab.held ? 1 : 0));
+      w.array(ab.hold);
+    }
     scheme.save(w);
     checkpoint::finish(w);
     options.on_checkpoint(ckpt);

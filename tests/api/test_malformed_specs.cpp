@@ -200,7 +200,7 @@ const Mutation mutations[] = {
     {"local_damping_formula_out_of_range", "/local_damping", "\"0.2 + 1e6 * t\"", "/local_damping",
      "local damping must lie in [0, 1)"},
     {"local_damping_not_number", "/local_damping", "true", "/local_damping",
-     "expected a number or a formula string in t"},
+     "expected a number, a formula string in t or {\"table\""},
     {"geostatic_conflicts_with_initial_fields", "/initial_state",
      R"({"geostatic": {"water_table": 0.5}})", "/bodies/0/initial/pore_pressure",
      "conflicts with initial_state.geostatic"},

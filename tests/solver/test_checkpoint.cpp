@@ -220,6 +220,21 @@ TEST_P(Resume, FromAMidRunCheckpointGivesTheUninterruptedResultsBitForBit) {
   expect_resume_as_whole(block(GetParam()), hmpm::scheme_name(GetParam()));
 }
 
+// The explicit block on an absorbing base shaken sideways: the base's
+// forces at rest, taken in the first step, are state (a resumed run that
+// took them again, from the state at the checkpoint, would hold the block
+// up with other forces).
+TEST(Resume, OnAShakenAbsorbingBase) {
+  hmpm::Problem p = block(hmpm::Scheme::explicit_scheme);
+  hmpm::Boundary base;
+  base.nodes = problems::plane(p, 1, 0.0);
+  base.absorbing = hmpm::Absorbing{1, 0};
+  base.velocity[0] = [](double t) { return 0.05 * std::sin(300.0 * t); };
+  p.boundaries[0] = base;
+  ASSERT_TRUE(hmpm::check_problem(p).empty());
+  expect_resume_as_whole(p, "absorbing base");
+}
+
 // A staged job: the explicit block, then a fill added above it with a
 // smaller Courant factor (a fresh scheme, another dt), then the fill
 // removed again. (The semi-implicit scheme cannot take this collapsing

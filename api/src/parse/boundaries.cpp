@@ -1,6 +1,6 @@
 // boundaries.cpp — the "boundaries" section: grid nodes with prescribed
-// velocity components, pore pressure, rigid ties, wall friction and seepage
-// faces.
+// velocity components (or accelerations), pore pressure, rigid ties, wall
+// friction, seepage faces and absorbing (viscous) boundaries.
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -34,8 +34,80 @@ std::int64_t count_selected_nodes(const Problem& p, const NodeSelection& nodes, 
   return n;
 }
 
-constexpr std::string_view boundary_allowed[] = {"nodes", "velocity", "pore_pressure",
-                                                 "rigid", "friction", "seepage"};
+constexpr std::string_view boundary_allowed[] = {"nodes",         "velocity", "acceleration",
+                                                 "pore_pressure", "rigid",    "friction",
+                                                 "seepage",       "absorbing"};
+constexpr std::string_view absorbing_allowed[] = {"normal", "material"};
+
+/// `absorbing`: true or {"normal": axis, "material": name}. The normal
+/// defaults to the one axis along which the node box is flat, the material
+/// to the job's only one.
+void read_absorbing(ParseContext& c, const json& j, const std::string& path, Boundary& b) {
+  SpecReader& r = c.r;
+  Absorbing ab;
+  bool normal_given = false, material_given = false;
+  if (j.is_boolean()) {
+    if (!j.get<bool>()) return;  // false: no dashpots
+  } else if (!j.is_object()) {
+    r.error(path, std::string("expected true or an object {\"normal\": \"x\"|\"y\"|\"z\", "
+                              "\"material\": name}, got ") +
+                      j.type_name());
+    return;
+  } else {
+    if (!r.object(j, path, absorbing_allowed)) return;
+    if (j.contains("normal")) {
+      const std::span<const std::string_view> axes(axis_names,
+                                                   static_cast<std::size_t>(std::max(c.dim, 1)));
+      if (auto s = r.one_of(j["normal"], path + "/normal", axes)) {
+        ab.normal = static_cast<int>(std::find(axes.begin(), axes.end(), *s) - axes.begin());
+        normal_given = true;
+      } else {
+        return;
+      }
+    }
+    if (j.contains("material")) {
+      const std::string mp = path + "/material";
+      const auto name = r.string(j["material"], mp, 100);
+      if (!name) return;
+      const auto it = c.material_index.find(*name);
+      if (it == c.material_index.end()) {
+        std::vector<std::string> names;
+        for (const auto& [n, i] : c.material_index) names.push_back(n);
+        r.error(mp, "unknown material '" + *name + "'; defined materials: " +
+                        (names.empty() ? std::string("none") : quoted_list(names)));
+        return;
+      }
+      ab.material = static_cast<std::size_t>(it->second);
+      material_given = true;
+    }
+  }
+  if (!normal_given) {
+    int flat = -1, flats = 0;
+    if (!b.nodes.all && !b.nodes.polygon)
+      for (int a = 0; a < c.dim; ++a)
+        if (b.nodes.box.min[a] == b.nodes.box.max[a]) {
+          flat = a;
+          ++flats;
+        }
+    if (c.dim == 1) {
+      ab.normal = 0;
+    } else if (flats == 1) {
+      ab.normal = flat;
+    } else {
+      r.error(path,
+              "needs 'normal' (the axis across the face: \"x\", \"y\" or \"z\"): the "
+              "nodes are not a box flat along exactly one axis");
+      return;
+    }
+  }
+  if (!material_given && c.p.materials.size() > 1) {
+    r.error(path, "needs 'material': the job has " + std::to_string(c.p.materials.size()) +
+                      " materials; name the medium beyond the boundary (the soil it "
+                      "bounds, or the rock below a compliant base)");
+    return;
+  }
+  b.absorbing = ab;
+}
 constexpr std::string_view boundary_required[] = {"nodes"};
 
 void read_boundary(ParseContext& c, const json& j, const std::string& path) {
@@ -64,8 +136,12 @@ void read_boundary(ParseContext& c, const json& j, const std::string& path) {
   }
   if (j.contains("seepage"))
     if (const auto s = r.boolean(j["seepage"], path + "/seepage")) b.seepage = *s;
-  if (!j.contains("velocity") && !j.contains("pore_pressure") && !j.contains("rigid") && !b.seepage)
-    r.error(path, "needs 'velocity', 'pore_pressure', 'rigid' and/or 'seepage'");
+  if (j.contains("absorbing")) read_absorbing(c, j["absorbing"], path + "/absorbing", b);
+  if (!j.contains("velocity") && !j.contains("acceleration") && !j.contains("pore_pressure") &&
+      !j.contains("rigid") && !b.seepage && !b.absorbing)
+    r.error(path,
+            "needs 'velocity', 'acceleration', 'pore_pressure', 'rigid', 'seepage' and/or "
+            "'absorbing'");
   if (j.contains("velocity")) {
     const json& v = j["velocity"];
     const std::string vp = path + "/velocity";
@@ -75,6 +151,28 @@ void read_boundary(ParseContext& c, const json& j, const std::string& path) {
         if (auto f = read_value_of_time(c, v[a], child_pointer(vp, a))) {
           b.velocity[a] = std::move(*f);
           b.has_velocity = true;
+        }
+      }
+    }
+  }
+  if (j.contains("acceleration")) {
+    // Integrated from rest at t = 0 to the velocity the solver uses.
+    const json& v = j["acceleration"];
+    const std::string vp = path + "/acceleration";
+    if (r.per_axis(v, vp, c.dim, "number, formula in t, table or null")) {
+      for (std::size_t a = 0; a < v.size() && a < 3; ++a) {
+        if (v[a].is_null()) continue;
+        const std::string ap = child_pointer(vp, a);
+        if (b.velocity[a]) {
+          r.error(ap, "and velocity/" + std::to_string(a) +
+                          " both give this component; give one (the velocity is the "
+                          "acceleration's integral from rest at t = 0)");
+          continue;
+        }
+        if (auto f = read_acceleration(c, v[a], ap)) {
+          b.velocity[a] = std::move(*f);
+          b.has_velocity = true;
+          b.from_acceleration[a] = true;
         }
       }
     }
@@ -108,7 +206,7 @@ void read_boundary(ParseContext& c, const json& j, const std::string& path) {
     } else if (auto mu = r.number(f, fp, Range::non_negative())) {
       b.friction = *mu;
     }
-    if (!j.contains("velocity"))
+    if (!j.contains("velocity") && !j.contains("acceleration"))
       r.error(fp, "needs 'velocity' with the wall-normal component prescribed and the others null");
   }
   if (j.contains("pore_pressure")) {
@@ -130,6 +228,7 @@ void boundary_keys(std::vector<SpecObjectKeys>& out) {
   out.push_back(keys_entry("/boundaries/*", boundary_allowed));
   out.push_back(keys_entry("/boundaries/*/nodes", selection_key_names()));
   out.push_back(keys_entry("/boundaries/*/nodes/box", box_key_names()));
+  out.push_back(keys_entry("/boundaries/*/absorbing", absorbing_allowed));
 }
 
 void read_boundaries(ParseContext& c, const json& j, const std::string& path) {

@@ -420,6 +420,7 @@ void resolve_consolidation(ParseContext& c) {
 }
 
 void check_whole_problem(ParseContext& c) {
+  integrate_accelerations(c);
   if (!check_particle_budget(c)) return;
   resolve_near(c);
   resolve_series_polygons(c);

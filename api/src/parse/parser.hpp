@@ -5,7 +5,8 @@
 // them: grid.cpp, materials.cpp (with material_models.cpp, the table of
 // constitutive models), bodies.cpp, boundaries.cpp, tractions.cpp,
 // initial_state.cpp, time.cpp, output.cpp; values.cpp reads what several
-// sections share (boxes, selections, formulas). Every reader records its
+// sections share (boxes, selections, formulas), motion.cpp tables of time
+// and accelerations. Every reader records its
 // problems in the ParseContext's SpecReader with their JSON pointers and
 // fills the Problem as it goes. checks.cpp then runs the checks that need
 // the whole Problem, locations.cpp turns the solver's issue locations into
@@ -13,6 +14,7 @@
 #pragma once
 
 #include <map>
+#include <memory>
 #include <optional>
 #include <span>
 #include <string>
@@ -60,6 +62,8 @@ struct PendingPolygon {
   std::string path;
 };
 
+struct IntegratedFormula;  // motion.cpp
+
 /// The state of one parse: the reader with its errors, the Problem being
 /// built and what the whole-problem checks need later.
 struct ParseContext {
@@ -77,6 +81,8 @@ struct ParseContext {
   std::vector<ProfileGeometry> profiles;  ///< output.profiles.lines, particles resolved later
   std::vector<PositionFormula> position_formulas;
   std::vector<TimeFormula> time_formulas;
+  /// Acceleration formulas, integrated by integrate_accelerations.
+  std::vector<std::shared_ptr<IntegratedFormula>> accelerations;
   bool damping_formula = false;         ///< local_damping given as a formula of t
   std::int64_t formula_characters = 0;  ///< of every formula read so far
   std::size_t formulas = 0;             ///< formulas read so far
@@ -125,9 +131,21 @@ Keys box_key_names();
 Keys selection_key_names();
 /// A number or a formula in x, y, z (recorded for the finiteness check).
 FieldOfPosition read_value_of_position(ParseContext& c, const json& j, const std::string& path);
-/// A number or a formula in t (recorded for the finiteness check).
+/// A number, a formula in t or a table {"table": [[t, v], ...]} (recorded
+/// for the finiteness check).
 std::optional<FieldOfTime> read_value_of_time(ParseContext& c, const json& j,
                                               const std::string& path);
+/// {"table": [[t, v], ...]}: piecewise linear, the end values held outside
+/// (motion.cpp).
+std::optional<FieldOfTime> read_table_of_time(ParseContext& c, const json& j,
+                                              const std::string& path);
+/// An acceleration (number, formula in t or table) as the velocity it
+/// integrates to from rest at t = 0 (motion.cpp).
+std::optional<FieldOfTime> read_acceleration(ParseContext& c, const json& j,
+                                             const std::string& path);
+/// Tabulates the integrals of the acceleration formulas over the job's
+/// time (once its end is known).
+void integrate_accelerations(ParseContext& c);
 /// A number or a formula in x, y, z, t; `varies_in_space` says whether it
 /// uses x, y or z. Checked for finite values over [0, end] at the grid's
 /// centre (with the formulas of time).

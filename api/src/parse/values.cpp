@@ -222,9 +222,11 @@ std::optional<FieldOfTime> read_value_of_time(ParseContext& c, const json& j,
     c.r.error(path, error);
     return std::nullopt;
   }
+  if (j.is_object()) return read_table_of_time(c, j, path);
   if (!j.is_number()) {
-    c.r.error(path,
-              std::string("expected a number or a formula string in t, got ") + j.type_name());
+    c.r.error(path, std::string("expected a number, a formula string in t or {\"table\": [[t, "
+                                "value], ...]}, got ") +
+                        j.type_name());
     return std::nullopt;
   }
   if (auto v = c.r.number(j, path)) return constant_field_of_time(*v);

@@ -12,6 +12,7 @@
 #pragma once
 
 #include <array>
+#include <cstddef>
 #include <cstdint>
 #include <functional>
 #include <limits>
@@ -162,12 +163,29 @@ struct NodeSelection {
   std::optional<Polygon> polygon;
 };
 
+/// A viscous (Lysmer-Kuhlemeyer) absorbing boundary: at each selected node
+/// the force C_a (v_in,a(t) - v_a) + the node's force at rest along every
+/// axis a, with C_a = rho c_a times the node's share of the face (c the
+/// P-wave speed along the normal, the S-wave speed along the others, of
+/// `material`: the undrained P modulus E_oed + 1/Q with pore water).
+/// v_in is the boundary's `velocity` (when given): the motion of a rock
+/// outcrop, so the wave sent in is half of it (a compliant base). The force
+/// at rest is the reaction the node needed in the first step its stage
+/// runs: the static load stays carried, the dynamic part is absorbed.
+struct Absorbing {
+  int normal = 0;            ///< the face's normal axis
+  std::size_t material = 0;  ///< index in Problem::materials: the medium beyond
+};
+
 /// Prescribed nodal velocity components and/or pore pressure.
 struct Boundary {
   NodeSelection nodes;
   /// One entry per axis; std::nullopt leaves that component free.
   std::array<std::optional<FieldOfTime>, 3> velocity;
   bool has_velocity = false;  ///< any velocity component prescribed
+  /// Per axis: the spec gave this velocity as an acceleration (integrated
+  /// from rest at t = 0); messages then name `acceleration`.
+  std::array<bool, 3> from_acceleration{false, false, false};
   std::optional<FieldOfTime> pore_pressure;
   /// When set, the prescribed pore pressure varies along the face: each
   /// node takes pore_pressure_field(its position, t) (a reservoir, p =
@@ -191,6 +209,9 @@ struct Boundary {
   /// held at p = 0 (it drains); one below zero is left free (no flow in).
   /// Not with a prescribed pore_pressure on the same entry.
   bool seepage = false;
+  /// Dashpots instead of prescribed velocities: `velocity` is then the
+  /// input (outcrop) motion, not a constraint.
+  std::optional<Absorbing> absorbing;
 };
 
 /// Surface load on one face of the particles inside `particles`.

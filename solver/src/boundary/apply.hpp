@@ -7,10 +7,12 @@
 // strain rate is computed from (apply_remap_constraints); pore pressure
 // constraints on the nodal pressure and its increment.
 //
-// PRECEDENCE (the one place it is decided: in_precedence_order). Where
-// several mechanisms act on the same velocity component of a node, they are
-// applied in this order, each later one overwriting what the earlier set:
-//   1. the free update of the grid phase (momentum + dt force);
+// PRECEDENCE (the one place it is decided: in_precedence_order, after
+// apply_absorbing). Where several mechanisms act on the same velocity
+// component of a node, they are applied in this order, each later one
+// overwriting what the earlier set:
+//   1. the free update of the grid phase (momentum + dt force), with the
+//      dashpots of absorbing boundaries (apply_absorbing) as forces in it;
 //   2. rigid ties: the tied components take the plate's velocity (summed
 //      momenta over summed masses) and acceleration;
 //   3. friction: the tangential components of a friction wall lose at most
@@ -84,6 +86,44 @@ inline void apply_friction(VelocityConstraint& bc, GridState<Dim>& grid, double 
       grid.accel[i][a] = (v[a] - v_start[a]) / dt;
     }
     bc.stuck[k] = stick ? 1 : 0;
+  }
+}
+
+/// Dashpots (absorbing boundaries) in the free update of the step t -> t +
+/// dt, implicit in the new velocity so that no node mass limits dt:
+///   m (v - v0) / dt = f + hold + C (v_in(t + dt) - v)
+///   =>  v = (m v_free + dt (hold + C v_in)) / (m + dt C),
+/// v_free = v0 + dt f / m the free update (after local damping), hold the
+/// node's force at rest: -(f + m g) of the first step of the stage (so
+/// a column at rest stays at rest; the dynamic part of the load is what the
+/// dashpot sees). The acceleration the particles receive is (v - v0) / dt.
+/// Explicit scheme only (the semi-implicit corrector would need the
+/// dashpots in its pressure system; check_problem refuses the pair).
+template <int Dim>
+inline void apply_absorbing(Constraints& c, GridState<Dim>& grid, const VecD<Dim>& gravity,
+                            double mass_tolerance, double t, double dt) {
+  for (AbsorbingConstraint& ab : c.absorbing) {
+    double v_in[3] = {0.0, 0.0, 0.0};
+    for (int a = 0; a < Dim; ++a)
+      if (ab.input[a]) v_in[a] = (*ab.input[a])(t + dt);
+    for (std::size_t k = 0; k < ab.nodes.size(); ++k) {
+      const std::int64_t i = ab.nodes[k];
+      const double m = grid.mass[i];
+      double* hold = &ab.hold[3 * k];
+      const double* coefficient = &ab.coefficient[3 * k];
+      if (!ab.held)
+        for (int a = 0; a < Dim; ++a)
+          hold[a] = m > mass_tolerance ? -(grid.force[i][a] + m * gravity[a]) : 0.0;
+      if (m <= mass_tolerance) continue;
+      for (int a = 0; a < Dim; ++a) {
+        const double v0 = grid.momentum[i][a] / m;
+        const double v = (m * grid.velocity[i][a] + dt * (hold[a] + coefficient[a] * v_in[a])) /
+                         (m + dt * coefficient[a]);
+        grid.velocity[i][a] = v;
+        grid.accel[i][a] = (v - v0) / dt;
+      }
+    }
+    ab.held = true;
   }
 }
 

@@ -3,19 +3,22 @@
 // Each Boundary of the Problem is compiled once, at set-up, into the
 // constraints it imposes on the grid: prescribed velocity components
 // (VelocityConstraint, optionally with Coulomb friction), rigid ties
-// (RigidTie: nodes sharing one velocity component) and prescribed pore
-// pressure (PressureConstraint). Which one wins where several meet at a node
-// is decided in one place, boundary/apply.hpp. Surface loads are in
+// (RigidTie: nodes sharing one velocity component), dashpots
+// (AbsorbingConstraint) and prescribed pore pressure (PressureConstraint). Which one wins where
+// several meet at a node is decided in one place, boundary/apply.hpp. Surface loads are in
 // boundary/tractions.hpp. Set-up code: allocates, never runs per step.
 #pragma once
 
+#include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <utility>
 #include <vector>
 
 #include "hmpm/problem.hpp"
 #include "hmpm/run.hpp"
+#include "materials/material.hpp"
 #include "state/grid.hpp"
 
 namespace hmpm {
@@ -67,6 +70,21 @@ struct PressureConstraint {
   }
 };
 
+/// Dashpots at a set of nodes (Boundary::absorbing): along each axis a the
+/// force C_a (v_in,a(t) - v_a) + hold, implicit in v (see apply.hpp).
+struct AbsorbingConstraint {
+  std::vector<std::int64_t> nodes;
+  /// Per node, 3 per node (axis a at 3 k + a): C = rho c_a times the node's
+  /// share of the face, N s/m.
+  std::vector<double> coefficient;
+  std::array<const FieldOfTime*, 3> input{nullptr, nullptr, nullptr};  ///< outcrop velocity
+  /// Per node, 3 per node: the force at rest, N, taken in the first step of
+  /// the stage (`held` from then on; kept in checkpoints).
+  std::vector<double> hold;
+  bool held = false;
+  std::size_t boundary = 0;  ///< index in Problem::boundaries (for its reaction)
+};
+
 /// Seepage face nodes (Boundary::seepage), less those whose pore pressure
 /// a boundary prescribes (a prescribed value wins).
 struct SeepageFace {
@@ -79,6 +97,7 @@ struct Constraints {
   std::vector<RigidTie> rigid_ties;
   std::vector<PressureConstraint> pressure;
   std::vector<SeepageFace> seepage;
+  std::vector<AbsorbingConstraint> absorbing;
   /// Per node (saturated runs): bit a set when a boundary prescribes or ties
   /// component a. Empty in dry runs.
   std::vector<std::uint8_t> prescribed_axes;
@@ -92,6 +111,54 @@ Vec3 node_position3(const GridState<Dim>& grid, std::int64_t i) {
   Vec3 x{0.0, 0.0, 0.0};
   for (int a = 0; a < Dim; ++a) x[a] = xn[a];
   return x;
+}
+
+/// The node's share of a face with normal axis `normal` through the
+/// selected nodes (`selected` per node): along each other axis the cell
+/// size, half of it where the face ends (a neighbour not selected or
+/// outside the grid). 1 in 1D.
+template <int Dim>
+double face_share(const GridState<Dim>& grid, const std::vector<std::uint8_t>& selected,
+                  std::int64_t i, int normal) {
+  double area = 1.0;
+  for (int a = 0; a < Dim; ++a) {
+    if (a == normal) continue;
+    const std::int64_t q = (i / grid.stride[a]) % (grid.cells[a] + 1);
+    const int below = q > 0 && selected[static_cast<std::size_t>(i - grid.stride[a])];
+    const int above = q < grid.cells[a] && selected[static_cast<std::size_t>(i + grid.stride[a])];
+    area *= grid.h[a] * std::max(0.5, 0.5 * (below + above));
+  }
+  return area;
+}
+
+/// The dashpots of boundary `bi`: impedances rho c of the material beyond
+/// (Absorbing::material) times each node's share of the face.
+template <int Dim>
+AbsorbingConstraint compile_absorbing(const Problem& problem, std::size_t bi,
+                                      const GridState<Dim>& grid,
+                                      const std::vector<std::int64_t>& nodes) {
+  const Boundary& b = problem.boundaries[bi];
+  const Absorbing& ab = *b.absorbing;
+  const MaterialConstants mc =
+      material_constants(problem.materials[ab.material], problem.gravity_constant);
+  const double rho = mc.mixture_density;
+  const double normal_impedance = std::sqrt(rho * mc.undrained_p_modulus);
+  const double shear_impedance = std::sqrt(rho * mc.shear_modulus);
+  AbsorbingConstraint c;
+  c.nodes = nodes;
+  c.boundary = bi;
+  for (int a = 0; a < Dim; ++a) c.input[a] = b.velocity[a] ? &*b.velocity[a] : nullptr;
+  std::vector<std::uint8_t> selected(static_cast<std::size_t>(grid.count), 0);
+  for (std::int64_t i : nodes) selected[static_cast<std::size_t>(i)] = 1;
+  c.coefficient.assign(3 * nodes.size(), 0.0);
+  c.hold.assign(3 * nodes.size(), 0.0);
+  for (std::size_t k = 0; k < nodes.size(); ++k) {
+    const double area = face_share(grid, selected, nodes[k], ab.normal);
+    for (int a = 0; a < Dim; ++a)
+      c.coefficient[3 * k + static_cast<std::size_t>(a)] =
+          area * (a == ab.normal ? normal_impedance : shear_impedance);
+  }
+  return c;
 }
 
 }  // namespace detail
@@ -108,7 +175,9 @@ Constraints compile_constraints(const Problem& problem, const GridState<Dim>& gr
     std::vector<std::int64_t> nodes;
     for (std::int64_t i = 0; i < grid.count; ++i)
       if (node_selected(problem, b.nodes, detail::node_position3(grid, i))) nodes.push_back(i);
-    if (b.has_velocity) {
+    if (b.absorbing) {
+      c.absorbing.push_back(detail::compile_absorbing(problem, bi, grid, nodes));
+    } else if (b.has_velocity) {
       VelocityConstraint vc;
       vc.nodes = nodes;
       vc.boundary = bi;

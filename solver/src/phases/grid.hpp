@@ -12,9 +12,9 @@
 
 namespace hmpm {
 
-/// Grid update: momentum += dt (f + m g) (with local damping), then the
-/// velocity constraints at t + dt. Gives the Lagrangian nodal velocity and
-/// the nodal acceleration used by the particles.
+/// Grid update: momentum += dt (f + m g) (with local damping), the
+/// dashpots of absorbing boundaries, then the velocity constraints at t + dt. Gives the Lagrangian
+/// nodal velocity and the nodal acceleration used by the particles.
 template <int Dim, class Shape>
 inline void Simulation<Dim, Shape>::update_nodal_momentum(double t, double dt) {
   const double alpha = damping_;
@@ -35,6 +35,7 @@ inline void Simulation<Dim, Shape>::update_nodal_momentum(double t, double dt) {
       grid_.velocity[i] = v0 + dt * grid_.accel[i];
     }
   });
+  apply_absorbing(constraints_, grid_, gravity_, mass_tolerance_, t, dt);
   apply_velocity_constraints(constraints_, grid_, mass_tolerance_, t, dt);
 }
 

@@ -8,7 +8,8 @@
 // explicit and semi-implicit steps, at a node component i, a:
 //   prescribed velocity (also a friction wall's normal,
 //   and its tangential components where it sticks):      R = m a_c - f
-//   friction (slipping, tangential) and rigid ties:      R = m a_c - f_damped
+//   friction (slipping, tangential), rigid ties and
+//   absorbing boundaries (the dashpot and the force at rest): R = m a_c - f_damped
 // with a_c the constrained nodal acceleration the particles receive, f =
 // f_int + f_p + f_traction + m g (+ the pressure increment's force in the
 // semi-implicit step) and f_damped f with the step's local damping. A
@@ -26,7 +27,8 @@
 //
 // Which boundary a node component is charged to (owner): the mechanism
 // applied last in the order of precedence of boundary/apply.hpp, i.e. a
-// prescribed velocity over friction over a rigid tie, and among two of the
+// prescribed velocity over friction over a rigid tie over a dashpot, and
+// among two of the
 // same kind the later boundary in the Problem. Set-up builds the list of
 // charged components once; each step that the time loop samples
 // (reactions_due_) sums over it: no allocation, proportional to the
@@ -53,6 +55,9 @@ void Simulation<Dim, Shape>::setup_reactions() {
     prescribed[d] = fixed ? 1 : 0;
     stuck[d] = flag;
   };
+  for (const AbsorbingConstraint& ab : constraints_.absorbing)
+    for (int a = 0; a < Dim; ++a)
+      for (std::int64_t i : ab.nodes) charge(i, a, ab.boundary, false, nullptr);
   for (const RigidTie& tie : constraints_.rigid_ties)
     for (int a = 0; a < Dim; ++a)
       if (tie.axes[a])
