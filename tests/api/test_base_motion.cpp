@@ -36,8 +36,8 @@ json column(const json& base) {
                                {"density", 1890.0},
                                {"youngs_modulus", 5e7},
                                {"poisson_ratio", 0.3}};
-  spec["bodies"] = json::array({{{"material", "soil"},
-                                 {"box", {{"min", one(0.0)}, {"max", one(10.0)}}}}});
+  spec["bodies"] =
+      json::array({{{"material", "soil"}, {"box", {{"min", one(0.0)}, {"max", one(10.0)}}}}});
   json b = base;
   b["nodes"] = {{"box", {{"min", one(0.0)}, {"max", one(0.0)}}}};
   spec["boundaries"] = json::array({b});
@@ -73,8 +73,8 @@ TEST(BaseMotion, AccelerationIntegratesToVelocity) {
   const FieldOfTime constant = base_velocity(column({{"acceleration", one(2.0)}}));
   EXPECT_DOUBLE_EQ(constant(0.75), 1.5);
   // a = 4 t on [0, 0.5] then 2 - 4 (t - 0.5) ... to 0 at t = 1: v = 2 t^2 first.
-  const FieldOfTime table = base_velocity(column(
-      {{"acceleration", json::array({{{"table", {{0.0, 0.0}, {0.5, 2.0}, {1.0, 0.0}}}}})}}));
+  const FieldOfTime table = base_velocity(
+      column({{"acceleration", json::array({{{"table", {{0.0, 0.0}, {0.5, 2.0}, {1.0, 0.0}}}}})}}));
   EXPECT_NEAR(table(0.25), 2 * 0.25 * 0.25, 1e-15);
   EXPECT_NEAR(table(0.75), 0.5 + (2.0 * 0.25 - 2.0 * 0.25 * 0.25), 1e-15);
   EXPECT_NEAR(table(1.5), 1.0, 1e-15);  // past the record: a = 0 holds
@@ -96,11 +96,10 @@ TEST(BaseMotion, BadTablesAndAccelerationsSayWhere) {
   EXPECT_NE(issue_at(column({{"velocity", json::array({{{"rows", {{0.2, 1.0}}}}})}}),
                      "/boundaries/0/velocity/0/rows"),
             "");
-  EXPECT_NE(
-      issue_at(column({{"velocity", one(0.0)}, {"acceleration", one(1.0)}}),
-               "/boundaries/0/acceleration/0")
-          .find("give one"),
-      std::string::npos);
+  EXPECT_NE(issue_at(column({{"velocity", one(0.0)}, {"acceleration", one(1.0)}}),
+                     "/boundaries/0/acceleration/0")
+                .find("give one"),
+            std::string::npos);
 }
 
 TEST(BaseMotion, AbsorbingDefaultsAndErrors) {
@@ -185,11 +184,11 @@ TEST(BaseMotion, ShakenLayerFromAnAccelerationOnACompliantBase) {
       {{{"material", "soil"}, {"box", {{"min", {0.0, 0.0}}, {"max", {H / cells, H}}}}}});
   spec["gravity"] = {0.0, 0.0};
   const std::string a = std::to_string(V * omega) + "*cos(" + std::to_string(omega) + "*t)";
-  spec["boundaries"] = json::array(
-      {{{"nodes", "all"}, {"velocity", {nullptr, 0.0}}},
-       {{"nodes", {{"box", {{"min", {0.0, 0.0}}, {"max", {H / cells, 0.0}}}}}},
-        {"absorbing", {{"material", "rock"}}},
-        {"acceleration", {a, nullptr}}}});
+  spec["boundaries"] =
+      json::array({{{"nodes", "all"}, {"velocity", {nullptr, 0.0}}},
+                   {{"nodes", {{"box", {{"min", {0.0, 0.0}}, {"max", {H / cells, 0.0}}}}}},
+                    {"absorbing", {{"material", "rock"}}},
+                    {"acceleration", {a, nullptr}}}});
   spec["time"] = {{"end", 14 * period}};
   const int top = 4 * cells - 1;
   spec["output"]["series"] = {

@@ -197,7 +197,8 @@ double shaken_amplitude_ratio(const Shaking& c, double* expected_out = nullptr) 
   // Rock: density 2400, shear impedance Z_soil / alpha (nu 0.3).
   const double rho_rock = 2400.0;
   const double cs_rock = std::sqrt(rho_dry * g_soil) / c.alpha / rho_rock;
-  p.materials.push_back(problems::elastic(rho_rock, 2 * (1 + nu) * rho_rock * cs_rock * cs_rock, nu));
+  p.materials.push_back(
+      problems::elastic(rho_rock, 2 * (1 + nu) * rho_rock * cs_rock * cs_rock, nu));
   hmpm::Boundary vertical;
   vertical.nodes.all = true;
   vertical.has_velocity = true;

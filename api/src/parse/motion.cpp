@@ -31,7 +31,8 @@ struct Table {
   double at(double x) const {
     if (x <= t.front()) return v.front();
     if (x >= t.back()) return v.back();
-    const auto k = static_cast<std::size_t>(std::upper_bound(t.begin(), t.end(), x) - t.begin()) - 1;
+    const auto k =
+        static_cast<std::size_t>(std::upper_bound(t.begin(), t.end(), x) - t.begin()) - 1;
     const double s = (x - t[k]) / (t[k + 1] - t[k]);
     return v[k] + s * (v[k + 1] - v[k]);
   }
@@ -43,7 +44,8 @@ struct Table {
     };
     if (x <= t.front()) return v.front() * x;
     if (x >= t.back()) return integral.back() + v.back() * (x - t.back());
-    const auto k = static_cast<std::size_t>(std::upper_bound(t.begin(), t.end(), x) - t.begin()) - 1;
+    const auto k =
+        static_cast<std::size_t>(std::upper_bound(t.begin(), t.end(), x) - t.begin()) - 1;
     return integral[k] + part(t[k], x);
   }
 
@@ -60,9 +62,9 @@ struct Table {
 /// An acceleration formula's velocity, tabulated by integrate_accelerations.
 struct IntegratedFormula {
   FieldOfTime a;
-  double panel = 0.0;             ///< panel length, s
-  std::vector<double> samples;    ///< a at 0, panel/2, panel, ... (2 per panel + 1)
-  std::vector<double> integral;   ///< from 0 to each panel's start (one per panel + 1)
+  double panel = 0.0;            ///< panel length, s
+  std::vector<double> samples;   ///< a at 0, panel/2, panel, ... (2 per panel + 1)
+  std::vector<double> integral;  ///< from 0 to each panel's start (one per panel + 1)
 
   double velocity(double t) const {
     if (integral.empty()) return 0.0;  // not built: the spec had errors
@@ -86,9 +88,8 @@ struct IntegratedFormula {
       samples[j] = a(0.5 * panel * static_cast<double>(j));
     integral.assign(panels + 1, 0.0);
     for (std::size_t k = 0; k < panels; ++k)
-      integral[k + 1] = integral[k] + panel / 6 *
-                                          (samples[2 * k] + 4 * samples[2 * k + 1] +
-                                           samples[2 * k + 2]);
+      integral[k + 1] =
+          integral[k] + panel / 6 * (samples[2 * k] + 4 * samples[2 * k + 1] + samples[2 * k + 2]);
   }
 };
 
@@ -124,10 +125,9 @@ std::optional<Table> read_table(ParseContext& c, const json& j, const std::strin
       continue;
     }
     if (!table.t.empty() && !(*t > table.t.back())) {
-      c.r.error(child_pointer(rp, 0), "is " + format_number(*t) +
-                                          " s, not after the previous row's " +
-                                          format_number(table.t.back()) +
-                                          " s; times must increase down the table");
+      c.r.error(child_pointer(rp, 0),
+                "is " + format_number(*t) + " s, not after the previous row's " +
+                    format_number(table.t.back()) + " s; times must increase down the table");
       ok = false;
     }
     table.t.push_back(*t);
