@@ -24,8 +24,8 @@ namespace column_waves {
 
 struct Column {
   double H = 0.5, porosity = 0.1, rho_s = 2222.0, rho_f = 1000.0;
-  double e_oed = 200e3;         ///< constrained modulus, Pa
-  double storage = 0.1 / 20e3;  ///< Q = n / Kf, 1/Pa
+  double e_oed = 200e3;          ///< constrained modulus, Pa
+  double storage = 0.1 / 20e3;   ///< Q = n / Kf, 1/Pa
   double kappa = 1e-4 / 9810.0;  ///< k / gamma_w
   double rho() const { return (1 - porosity) * rho_s + porosity * rho_f; }
   double fast_speed() const { return std::sqrt((e_oed + 1 / storage) / rho()); }
@@ -34,9 +34,9 @@ struct Column {
 /// sigma' and p at `depths` (from the top) at each of `times`, rows in time
 /// order: out[t][2 d] = sigma', out[t][2 d + 1] = p.
 inline std::vector<std::vector<double>> reference(const Column& c,
-                                                   const std::function<double(double)>& load,
-                                                   int cells, const std::vector<double>& times,
-                                                   const std::vector<double>& depths) {
+                                                  const std::function<double(double)>& load,
+                                                  int cells, const std::vector<double>& times,
+                                                  const std::vector<double>& depths) {
   const int n = cells;
   const double h = c.H / n, rho = c.rho();
   const double dt = 0.25 * std::min(h / c.fast_speed(), c.storage * h * h / (2 * c.kappa));

@@ -72,8 +72,8 @@ double hmpm_error(double kf, hmpm::ShapeFunction shape, int cells) {
   const Column c = column(kf);
   hmpm::Problem p = problems::column(1, 0, c.H, cells, 2);
   p.shape_function = shape;
-  p.materials.push_back(problems::saturated_elastic(c.rho_s, 180e3, 0.2, c.porosity,
-                                                    c.kappa * 9810.0, kf));
+  p.materials.push_back(
+      problems::saturated_elastic(c.rho_s, 180e3, 0.2, c.porosity, c.kappa * 9810.0, kf));
   p.boundaries.push_back(problems::fixed_velocity(problems::plane(p, 0, 0.0), 0));
   p.boundaries.push_back(problems::fixed_pressure(problems::plane(p, 0, c.H), 0.0));
   hmpm::Traction t;
