@@ -26,8 +26,9 @@
 //            (those of the stage in force: a resumed run first replays the
 //            stages' moves of bodies)
 //   absorbing  u64 the absorbing boundaries of the stage in force, per
-//            boundary u8 whether its forces at rest are taken and their
-//            array (boundary/constraints.hpp)
+//            boundary u8 whether its forces at rest are taken, their array
+//            and the array of its dashpots (from the particles where the
+//            stage began; boundary/constraints.hpp)
 //   scheme   TimeScheme::save (e.g. the semi-implicit solver's initial
 //            guess, the quasi-static step plan and counters)
 //   trailer  u64 FNV-1a hash of everything before it

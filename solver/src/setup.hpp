@@ -32,7 +32,7 @@ Simulation<Dim, Shape>::Simulation(const Problem& problem, const RunOptions& opt
   setup_stages();
   interrupt_.stage("compiling boundaries and tractions");
   interrupt_.check();
-  constraints_ = compile_constraints<Dim>(problem_, grid_, grid_max_, fluid_);
+  constraints_ = compile_constraints<Dim>(problem_, grid_, grid_max_, fluid_, particles_);
   tractions_ = compile_tractions<Dim>(problem_, particles_, particles_.volume, grid_);
   if (fluid_) fluxes_ = compile_fluxes<Dim>(problem_, particles_, particles_.volume, grid_);
   if (problem_.output.reactions_interval > 0) setup_reactions();

@@ -64,7 +64,7 @@ void Simulation<Dim, Shape>::enter_stage(std::size_t k) {
   std::vector<double> volume0(particles_.size());
   for (std::size_t p = 0; p < particles_.size(); ++p)
     volume0[p] = particles_.mass[p] / constants_[particles_.material[p]].mixture_density;
-  constraints_ = compile_constraints<Dim>(problem_, grid_, grid_max_, fluid_);
+  constraints_ = compile_constraints<Dim>(problem_, grid_, grid_max_, fluid_, particles_);
   tractions_ = compile_tractions<Dim>(problem_, particles_, volume0, grid_);
   if (fluid_) fluxes_ = compile_fluxes<Dim>(problem_, particles_, volume0, grid_);
   if (problem_.output.reactions_interval > 0) setup_reactions();

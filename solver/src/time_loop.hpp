@@ -234,6 +234,8 @@ RunResult Simulation<Dim, Shape>::run(const RunOptions& options) {
     for (AbsorbingConstraint& ab : constraints_.absorbing) {
       ab.held = r.pod<std::uint8_t>() != 0;
       r.array(ab.hold, static_cast<std::int64_t>(ab.hold.size()), "absorbing boundary's forces");
+      r.array(ab.coefficient, static_cast<std::int64_t>(ab.coefficient.size()),
+              "absorbing boundary's dashpots");
     }
   } else {
     if (want_series) sample_series(series, 0.0);
@@ -300,6 +302,7 @@ RunResult Simulation<Dim, Shape>::run(const RunOptions& options) {
     for (const AbsorbingConstraint& ab : constraints_.absorbing) {
       w.pod(static_cast<std::uint8_t>(ab.held ? 1 : 0));
       w.array(ab.hold);
+      w.array(ab.coefficient);  // from the particles where the stage began
     }
     scheme.save(w);
     checkpoint::finish(w);

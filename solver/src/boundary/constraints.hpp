@@ -113,29 +113,79 @@ Vec3 node_position3(const GridState<Dim>& grid, std::int64_t i) {
   return x;
 }
 
-/// The node's share of a face with normal axis `normal` through the
-/// selected nodes (`selected` per node): along each other axis the cell
-/// size, half of it where the face ends (a neighbour not selected or
-/// outside the grid). 1 in 1D.
+/// The node's share of a face with normal axis `normal` that the soil
+/// covers: its tributary region on the face (the cell size along each face
+/// axis, [x - h/2, x + h/2] clipped to the grid) times the fraction of it
+/// that lies under particles next to the face (those in the cells around
+/// the node, each a cube of its volume), sampled on 8 points per face axis.
+/// A base wider than the soil above it thereby gets dashpots where the soil
+/// is, not where the selection is. 1 in 1D.
 template <int Dim>
-double face_share(const GridState<Dim>& grid, const std::vector<std::uint8_t>& selected,
-                  std::int64_t i, int normal) {
+double covered_face_share(const GridState<Dim>& grid, const ParticleState<Dim>& particles,
+                          const std::vector<std::vector<std::size_t>>& in_cell, std::int64_t i,
+                          int normal) {
+  if (Dim == 1) return 1.0;
+  constexpr int samples = 8;
+  std::array<std::int64_t, Dim> q{};
   double area = 1.0;
+  std::array<double, Dim> lo{}, step{};
   for (int a = 0; a < Dim; ++a) {
+    q[a] = (i / grid.stride[a]) % (grid.cells[a] + 1);
     if (a == normal) continue;
-    const std::int64_t q = (i / grid.stride[a]) % (grid.cells[a] + 1);
-    const int below = q > 0 && selected[static_cast<std::size_t>(i - grid.stride[a])];
-    const int above = q < grid.cells[a] && selected[static_cast<std::size_t>(i + grid.stride[a])];
-    area *= grid.h[a] * std::max(0.5, 0.5 * (below + above));
+    const double x = grid.origin[a] + static_cast<double>(q[a]) * grid.h[a];
+    const double from = q[a] > 0 ? x - 0.5 * grid.h[a] : x;
+    const double to = q[a] < grid.cells[a] ? x + 0.5 * grid.h[a] : x;
+    area *= to - from;
+    lo[a] = from;
+    step[a] = (to - from) / samples;
   }
-  return area;
+  // The particles in the cells that share node i.
+  std::vector<std::size_t> near;
+  for (int corner = 0; corner < (1 << Dim); ++corner) {
+    std::int64_t cell = 0, stride = 1;
+    bool inside = true;
+    for (int a = 0; a < Dim; ++a) {
+      const std::int64_t c = q[a] - ((corner >> a) & 1);
+      inside = inside && c >= 0 && c < grid.cells[a];
+      cell += c * stride;
+      stride *= grid.cells[a];
+    }
+    if (inside)
+      for (std::size_t p : in_cell[static_cast<std::size_t>(cell)]) near.push_back(p);
+  }
+  int covered = 0, total = 0;
+  const int points = Dim == 2 ? samples : samples * samples;
+  for (int k = 0; k < points; ++k) {
+    std::array<double, Dim> s{};
+    int rest = k;
+    for (int a = 0; a < Dim; ++a) {
+      if (a == normal) continue;
+      s[a] = lo[a] + (static_cast<double>(rest % samples) + 0.5) * step[a];
+      rest /= samples;
+    }
+    ++total;
+    for (std::size_t p : near) {
+      const double half = 0.5 * std::pow(particles.volume[p], 1.0 / Dim);
+      bool under = true;
+      for (int a = 0; a < Dim; ++a)
+        if (a != normal) under = under && std::abs(s[a] - particles.x[p][a]) <= half;
+      if (under) {
+        ++covered;
+        break;
+      }
+    }
+  }
+  return area * static_cast<double>(covered) / static_cast<double>(total);
 }
 
 /// The dashpots of boundary `bi`: impedances rho c of the material beyond
-/// (Absorbing::material) times each node's share of the face.
+/// (Absorbing::material) times each node's share of the face the soil
+/// covers (`in_cell`: the particles of each grid cell).
 template <int Dim>
 AbsorbingConstraint compile_absorbing(const Problem& problem, std::size_t bi,
                                       const GridState<Dim>& grid,
+                                      const ParticleState<Dim>& particles,
+                                      const std::vector<std::vector<std::size_t>>& in_cell,
                                       const std::vector<std::int64_t>& nodes) {
   const Boundary& b = problem.boundaries[bi];
   const Absorbing& ab = *b.absorbing;
@@ -148,12 +198,10 @@ AbsorbingConstraint compile_absorbing(const Problem& problem, std::size_t bi,
   c.nodes = nodes;
   c.boundary = bi;
   for (int a = 0; a < Dim; ++a) c.input[a] = b.velocity[a] ? &*b.velocity[a] : nullptr;
-  std::vector<std::uint8_t> selected(static_cast<std::size_t>(grid.count), 0);
-  for (std::int64_t i : nodes) selected[static_cast<std::size_t>(i)] = 1;
   c.coefficient.assign(3 * nodes.size(), 0.0);
   c.hold.assign(3 * nodes.size(), 0.0);
   for (std::size_t k = 0; k < nodes.size(); ++k) {
-    const double area = face_share(grid, selected, nodes[k], ab.normal);
+    const double area = covered_face_share(grid, particles, in_cell, nodes[k], ab.normal);
     for (int a = 0; a < Dim; ++a)
       c.coefficient[3 * k + static_cast<std::size_t>(a)] =
           area * (a == ab.normal ? normal_impedance : shear_impedance);
@@ -164,19 +212,41 @@ AbsorbingConstraint compile_absorbing(const Problem& problem, std::size_t bi,
 }  // namespace detail
 
 /// Compiles the boundaries of `problem` on `grid` (whose upper corner is
-/// `grid_max`). Pressure constraints only when `fluid` (a saturated run).
-/// `problem` must outlive the result (the constraints point to its fields).
+/// `grid_max`) for the particles in the run. Pressure constraints only when `fluid` (a saturated
+/// run). `problem` must outlive the result (the constraints point to its fields).
 template <int Dim>
 Constraints compile_constraints(const Problem& problem, const GridState<Dim>& grid,
-                                const VecD<Dim>& grid_max, bool fluid) {
+                                const VecD<Dim>& grid_max, bool fluid,
+                                const ParticleState<Dim>& particles) {
   Constraints c;
+  // The particles of each cell, for the absorbing boundaries' face shares.
+  std::vector<std::vector<std::size_t>> in_cell;
+  if (std::any_of(problem.boundaries.begin(), problem.boundaries.end(),
+                  [](const Boundary& b) { return b.absorbing.has_value(); })) {
+    std::int64_t cells = 1;
+    for (int a = 0; a < Dim; ++a) cells *= grid.cells[a];
+    in_cell.resize(static_cast<std::size_t>(cells));
+    for (std::size_t p = 0; p < particles.size(); ++p) {
+      std::int64_t cell = 0, stride = 1;
+      for (int a = 0; a < Dim; ++a) {
+        const auto k = std::clamp<std::int64_t>(
+            static_cast<std::int64_t>(
+                std::floor((particles.x[p][a] - grid.origin[a]) * grid.inv_h[a])),
+            0, grid.cells[a] - 1);
+        cell += k * stride;
+        stride *= grid.cells[a];
+      }
+      in_cell[static_cast<std::size_t>(cell)].push_back(p);
+    }
+  }
   for (std::size_t bi = 0; bi < problem.boundaries.size(); ++bi) {
     const Boundary& b = problem.boundaries[bi];
     std::vector<std::int64_t> nodes;
     for (std::int64_t i = 0; i < grid.count; ++i)
       if (node_selected(problem, b.nodes, detail::node_position3(grid, i))) nodes.push_back(i);
     if (b.absorbing) {
-      c.absorbing.push_back(detail::compile_absorbing(problem, bi, grid, nodes));
+      c.absorbing.push_back(
+          detail::compile_absorbing(problem, bi, grid, particles, in_cell, nodes));
     } else if (b.has_velocity) {
       VelocityConstraint vc;
       vc.nodes = nodes;
