@@ -40,6 +40,21 @@ hmpm::Boundary absorbing_plane(const hmpm::Problem& p, int axis, std::size_t mat
   return b;
 }
 
+/// A 2D block of the §12 soil filling the grid [0, width] x [0, height] of
+/// nx x ny cells, 2 x 2 particles per cell, no boundaries yet.
+hmpm::Problem soil_block_2d(double width, double height, int nx, int ny) {
+  hmpm::Problem p;
+  p.dimension = 2;
+  p.grid.max = {width, height, 0.0};
+  p.grid.cells = {nx, ny, 1};
+  hmpm::Body b;
+  b.box.max = p.grid.max;
+  b.particles_per_cell = 2;
+  p.bodies.push_back(b);
+  p.materials.push_back(problems::elastic(rho_dry, E, nu));
+  return p;
+}
+
 struct Pulse {
   int cells = 100;
   hmpm::ShapeFunction shape = hmpm::ShapeFunction::linear;
@@ -180,18 +195,7 @@ struct Shaking {
 // this by the api: tests/api/test_base_motion.cpp).
 // Returns the steady amplitude at the top particle over the closed form.
 double shaken_amplitude_ratio(const Shaking& c, double* expected_out = nullptr) {
-  hmpm::Problem p;
-  p.dimension = 2;
-  const double h = L / c.cells;
-  p.grid.min = {0.0, 0.0, 0.0};
-  p.grid.max = {h, L, 0.0};
-  p.grid.cells = {1, c.cells, 1};
-  hmpm::Body b;
-  b.box.min = p.grid.min;
-  b.box.max = p.grid.max;
-  b.particles_per_cell = 2;
-  p.bodies.push_back(b);
-  p.materials.push_back(problems::elastic(rho_dry, E, nu));
+  hmpm::Problem p = soil_block_2d(L / c.cells, L, 1, c.cells);
   const double g_soil = E / (2 * (1 + nu));
   const double cs = std::sqrt(g_soil / rho_dry);
   // Rock: density 2400, shear impedance Z_soil / alpha (nu 0.3).
@@ -279,6 +283,132 @@ TEST(Absorbing, ColumnAtRestUnderGravityStaysAtRest) {
   ASSERT_FALSE(r.reactions.force.empty());
   const double weight = rho_dry * 9.81 * L;
   EXPECT_NEAR(r.reactions.force[0].back(), weight, 1e-9 * weight);
+}
+
+}  // namespace
+
+namespace {
+
+// Energy in a 2D box of the §12 soil, 20 m wide and 10 m deep (0.5 m
+// cells), after a pulse of pressure on a 1 m strip at the middle of its free
+// top (a Hann pulse of 0.05 s: 19 cells per P wavelength, 10 per S; a
+// shorter pulse trails a numerical dispersion tail that rings in the box
+// whatever its walls): P, S and Rayleigh waves meet the sides and the base at
+// every angle. With absorbing sides and base (normal x, x and y) the energy
+// left in the box falls to a few percent of the largest it held; with roller
+// walls it stays (the control, 97 %). Lysmer's dashpots are exact only for
+// waves meeting them head-on (a few percent reflected at 30 degrees), and
+// the Rayleigh wave meets the sides in the corners: measured 3.2 % left at
+// 0.5 s and 1.7 % at 1 s, asserted below 3 % at 1 s and falling (below
+// 0.75 of what was left at 0.5 s).
+/// A Hann pulse of pressure q0 sin^2(pi t / T), t < T, on the y+ face of
+/// the particles in [lo, hi] (2D).
+hmpm::Traction hann_pulse(const hmpm::Vec3& lo, const hmpm::Vec3& hi, double q0, double T) {
+  hmpm::Traction t;
+  t.particles.min = lo;
+  t.particles.max = hi;
+  t.axis = 1;
+  t.side = +1;
+  t.traction[1] = [q0, T](double time) {
+    const double s = std::sin(pi * time / T);
+    return time < T ? -q0 * s * s : 0.0;
+  };
+  return t;
+}
+
+struct BoxEnergy {
+  double peak = 0, at_half = 0, at_end = 0;
+};
+
+BoxEnergy pulse_in_a_box(bool absorbing) {
+  hmpm::Problem p = soil_block_2d(20.0, 10.0, 40, 20);
+  for (const auto& [axis, at] : {std::pair{0, 0.0}, std::pair{0, 20.0}, std::pair{1, 0.0}}) {
+    hmpm::Boundary w;
+    w.nodes = problems::plane(p, axis, at);
+    if (absorbing) {
+      w.absorbing = hmpm::Absorbing{axis, 0};
+    } else {
+      w.has_velocity = true;
+      w.velocity[axis] = problems::constant(0.0);
+    }
+    p.boundaries.push_back(w);
+  }
+  p.tractions.push_back(hann_pulse({9.5, 9.75, 0.0}, {10.5, 10.0, 0.0}, 1e5, 0.05));
+  p.time.end = 1.0;
+  p.output.snapshot_interval = 0.02;
+  p.output.snapshot_fields = {hmpm::Field::velocity, hmpm::Field::effective_stress,
+                              hmpm::Field::strain};
+  BoxEnergy e;
+  hmpm::RunOptions opt;
+  opt.on_snapshot = [&](const hmpm::Snapshot& s) {
+    double energy = 0;
+    for (std::int64_t i = 0; i < s.particles; ++i) {
+      for (int a = 0; a < 2; ++a)
+        energy += 0.5 * s.mass[i] * s.velocity[3 * i + a] * s.velocity[3 * i + a];
+      for (int k = 0; k < 6; ++k)
+        energy += 0.5 * s.volume[i] * (k < 3 ? 1.0 : 2.0) * s.effective_stress[6 * i + k] *
+                  s.strain[6 * i + k];
+    }
+    e.peak = std::max(e.peak, energy);
+    if (std::abs(s.time - 0.5) < 0.01) e.at_half = energy;
+    e.at_end = energy;
+  };
+  const hmpm::RunResult r = hmpm::run(p, opt);
+  EXPECT_EQ(r.status, hmpm::RunStatus::successful) << r.message;
+  return e;
+}
+
+TEST(Absorbing, WavesLeaveABoxThroughItsSidesAndBase) {
+  const BoxEnergy walls = pulse_in_a_box(false);
+  const BoxEnergy dashpots = pulse_in_a_box(true);
+  std::printf(
+      "[ absorbing ] box: energy left at 0.5 s / 1 s of the peak: walls %.3f / %.3f, "
+      "absorbing %.4f / %.4f\n",
+      walls.at_half / walls.peak, walls.at_end / walls.peak, dashpots.at_half / dashpots.peak,
+      dashpots.at_end / dashpots.peak);
+  EXPECT_GT(walls.at_end, 0.8 * walls.peak);
+  EXPECT_LT(dashpots.at_end, 0.03 * dashpots.peak);
+  EXPECT_LT(dashpots.at_end, 0.75 * dashpots.at_half);
+}
+
+}  // namespace
+
+namespace {
+
+// The dashpots' face shares come from the particles next to the face; with
+// cells 5x wider than tall (0.5 m x 0.1 m) a plane P pulse through a 2D
+// column two cells wide must leave as it does in 1D (measured 1.0 %; the
+// share taken from a square particle of the same volume halved the
+// dashpots, and 33 % came back).
+TEST(Absorbing, PlaneWaveLeavesThroughABaseOfFlatCells) {
+  hmpm::Problem p = soil_block_2d(1.0, L, 2, 100);
+  hmpm::Boundary rollers;
+  rollers.nodes.all = true;
+  rollers.has_velocity = true;
+  rollers.velocity[0] = problems::constant(0.0);
+  p.boundaries.push_back(rollers);
+  p.boundaries.push_back(absorbing_plane(p, 1));
+  p.tractions.push_back(hann_pulse({0.0, L - 0.05, 0.0}, {1.0, L, 0.0}, 1e4, 0.02));
+  p.time.end = 0.12;
+  const double speed = std::sqrt(e_oed / rho_dry), back = (L + L / 2) / speed;
+  // The particle at x = 0.125 m nearest y = 5 m: particles are numbered x
+  // fastest, 4 across (2 cells x 2), rows 0.05 m apart from y = 0.025 m.
+  const std::int64_t nearest = std::int64_t{4} * 100;  // y = 0.025 + 0.05 * 100 = 5.025 m
+  p.output.series_particles = {nearest};
+  p.output.series_fields = {hmpm::Field::velocity};
+  p.output.series_interval = 0.0005;
+  const hmpm::RunResult r = hmpm::run(p);
+  ASSERT_EQ(r.status, hmpm::RunStatus::successful) << r.message;
+  ASSERT_NEAR(r.series.initial_positions[0][0], 0.125, 1e-9);
+  ASSERT_NEAR(r.series.initial_positions[0][1], 5.025, 1e-9);
+  double incident = 0, returned = 0;
+  for (std::size_t k = 0; k < r.series.time.size(); ++k) {
+    double& peak = r.series.time[k] < back - 0.002 ? incident : returned;
+    peak = std::max(peak, std::abs(r.series.values[0][2 * k + 1]));
+  }
+  std::printf("[ absorbing ] flat cells: returned %.4f\n", returned / incident);
+  EXPECT_NEAR(incident, 1e4 / std::sqrt(rho_dry * e_oed), 0.05 * incident);
+  EXPECT_LT(returned / incident, 0.02);
 }
 
 }  // namespace

@@ -117,7 +117,8 @@ Vec3 node_position3(const GridState<Dim>& grid, std::int64_t i) {
 /// covers: its tributary region on the face (the cell size along each face
 /// axis, [x - h/2, x + h/2] clipped to the grid) times the fraction of it
 /// that lies under particles next to the face (those in the cells around
-/// the node, each a cube of its volume), sampled on 8 points per face axis.
+/// the node, each the box of its share of a cell: h_a / n along axis a, n
+/// per axis from its volume), sampled on 8 points per face axis.
 /// A base wider than the soil above it thereby gets dashpots where the soil
 /// is, not where the selection is. 1 in 1D.
 template <int Dim>
@@ -165,10 +166,15 @@ double covered_face_share(const GridState<Dim>& grid, const ParticleState<Dim>& 
     }
     ++total;
     for (std::size_t p : near) {
-      const double half = 0.5 * std::pow(particles.volume[p], 1.0 / Dim);
+      // Particles fill cells on a regular n x n (x n) pattern: n from the
+      // particle's volume, its extent along axis a half of h_a / n each way.
+      double cell_volume = 1.0;
+      for (int a = 0; a < Dim; ++a) cell_volume *= grid.h[a];
+      const double per_axis = std::pow(cell_volume / particles.volume[p], 1.0 / Dim);
       bool under = true;
       for (int a = 0; a < Dim; ++a)
-        if (a != normal) under = under && std::abs(s[a] - particles.x[p][a]) <= half;
+        if (a != normal)
+          under = under && std::abs(s[a] - particles.x[p][a]) <= 0.5 * grid.h[a] / per_axis;
       if (under) {
         ++covered;
         break;
