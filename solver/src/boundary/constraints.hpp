@@ -123,8 +123,8 @@ Vec3 node_position3(const GridState<Dim>& grid, std::int64_t i) {
 /// is, not where the selection is. 1 in 1D.
 template <int Dim>
 double covered_face_share(const GridState<Dim>& grid, const ParticleState<Dim>& particles,
-                          const std::vector<std::vector<std::size_t>>& in_cell, std::int64_t i,
-                          int normal) {
+                          const std::vector<std::pair<std::int64_t, std::size_t>>& in_cell,
+                          std::int64_t i, int normal) {
   if (Dim == 1) return 1.0;
   constexpr int samples = 8;
   std::array<std::int64_t, Dim> q{};
@@ -151,8 +151,11 @@ double covered_face_share(const GridState<Dim>& grid, const ParticleState<Dim>& 
       cell += c * stride;
       stride *= grid.cells[a];
     }
-    if (inside)
-      for (std::size_t p : in_cell[static_cast<std::size_t>(cell)]) near.push_back(p);
+    if (!inside) continue;
+    const auto first = std::lower_bound(in_cell.begin(), in_cell.end(),
+                                        std::pair<std::int64_t, std::size_t>{cell, 0});
+    for (auto it = first; it != in_cell.end() && it->first == cell; ++it)
+      near.push_back(it->second);
   }
   int covered = 0, total = 0;
   const int points = Dim == 2 ? samples : samples * samples;
@@ -186,13 +189,13 @@ double covered_face_share(const GridState<Dim>& grid, const ParticleState<Dim>& 
 
 /// The dashpots of boundary `bi`: impedances rho c of the material beyond
 /// (Absorbing::material) times each node's share of the face the soil
-/// covers (`in_cell`: the particles of each grid cell).
+/// covers (`in_cell`: (grid cell, particle) pairs, sorted).
 template <int Dim>
-AbsorbingConstraint compile_absorbing(const Problem& problem, std::size_t bi,
-                                      const GridState<Dim>& grid,
-                                      const ParticleState<Dim>& particles,
-                                      const std::vector<std::vector<std::size_t>>& in_cell,
-                                      const std::vector<std::int64_t>& nodes) {
+AbsorbingConstraint compile_absorbing(
+    const Problem& problem, std::size_t bi, const GridState<Dim>& grid,
+    const ParticleState<Dim>& particles,
+    const std::vector<std::pair<std::int64_t, std::size_t>>& in_cell,
+    const std::vector<std::int64_t>& nodes) {
   const Boundary& b = problem.boundaries[bi];
   const Absorbing& ab = *b.absorbing;
   const MaterialConstants mc =
@@ -225,13 +228,13 @@ Constraints compile_constraints(const Problem& problem, const GridState<Dim>& gr
                                 const VecD<Dim>& grid_max, bool fluid,
                                 const ParticleState<Dim>& particles) {
   Constraints c;
-  // The particles of each cell, for the absorbing boundaries' face shares.
-  std::vector<std::vector<std::size_t>> in_cell;
+  // (cell, particle) of every particle, sorted: the particles of a cell,
+  // for the absorbing boundaries' face shares (memory per particle, not
+  // per cell).
+  std::vector<std::pair<std::int64_t, std::size_t>> in_cell;
   if (std::any_of(problem.boundaries.begin(), problem.boundaries.end(),
                   [](const Boundary& b) { return b.absorbing.has_value(); })) {
-    std::int64_t cells = 1;
-    for (int a = 0; a < Dim; ++a) cells *= grid.cells[a];
-    in_cell.resize(static_cast<std::size_t>(cells));
+    in_cell.reserve(particles.size());
     for (std::size_t p = 0; p < particles.size(); ++p) {
       std::int64_t cell = 0, stride = 1;
       for (int a = 0; a < Dim; ++a) {
@@ -242,8 +245,9 @@ Constraints compile_constraints(const Problem& problem, const GridState<Dim>& gr
         cell += k * stride;
         stride *= grid.cells[a];
       }
-      in_cell[static_cast<std::size_t>(cell)].push_back(p);
+      in_cell.emplace_back(cell, p);
     }
+    std::sort(in_cell.begin(), in_cell.end());
   }
   for (std::size_t bi = 0; bi < problem.boundaries.size(); ++bi) {
     const Boundary& b = problem.boundaries[bi];
