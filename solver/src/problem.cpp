@@ -581,6 +581,8 @@ std::string darcy_growth_advice(const Material& m, const MaterialConstants& c) {
 
 }  // namespace
 
+namespace {
+
 /// A boundary on a face of the grid whose velocity (prescribed, or the
 /// input motion of an absorbing base) carries the soil towards the grid's
 /// edge further than the room there: a shaken base moves the whole layer
@@ -593,8 +595,7 @@ std::string darcy_growth_advice(const Material& m, const MaterialConstants& c) {
 void check_room_for_motion(const Problem& problem, const std::vector<BodyLayout>& layouts,
                            std::vector<ProblemIssue>& warnings) {
   const int dim = problem.dimension;
-  double end = problem.time.end;
-  for (const Stage& s : problem.stages) end = std::max(end, s.end);
+  const double end = job_end_time(problem);
   for (std::size_t i = 0; i < problem.boundaries.size(); ++i) {
     const Boundary& b = problem.boundaries[i];
     if (b.nodes.all || b.nodes.polygon) continue;
@@ -623,7 +624,7 @@ void check_room_for_motion(const Problem& problem, const std::vector<BodyLayout>
       // Room along a: between the particles (half a spacing inside the
       // filled extent) and the grid's edges.
       double below = std::numeric_limits<double>::infinity(), above = below;
-      const double h = (problem.grid.max[a] - problem.grid.min[a]) / problem.grid.cells[a];
+      const double h = cell_size(problem, a);
       for (std::size_t k = 0; k < layouts.size(); ++k) {
         if (layouts[k].count == 0) continue;
         const double half = 0.5 * h / problem.bodies[k].particles_per_cell;
@@ -694,13 +695,14 @@ void check_cell_crossing(const Problem& problem, const std::vector<BodyLayout>& 
       }
     double peak = 0.0;
     constexpr int samples = 200;
+    const double end = job_end_time(problem);
     for (int k = 0; k <= samples; ++k) {
-      const double t = problem.time.end * k / samples;
+      const double t = end * k / samples;
       for (int c = 0; c < problem.dimension; ++c)
         if (tr.traction[c]) peak = std::max(peak, std::abs(tr.traction[c](t)));
     }
     const double move = peak * (hi - lo) / modulus;
-    const double h = (problem.grid.max[a] - problem.grid.min[a]) / problem.grid.cells[a];
+    const double h = cell_size(problem, a);
     if (!(move > 0.25 * h)) continue;
     warnings.push_back(
         {Location{"tractions"} / i,
@@ -714,6 +716,8 @@ void check_cell_crossing(const Problem& problem, const std::vector<BodyLayout>& 
              "(a finer grid makes the crossings more frequent, not fewer)"});
   }
 }
+
+}  // namespace
 
 std::vector<ProblemIssue> problem_warnings(const Problem& problem) {
   std::vector<ProblemIssue> warnings;
@@ -856,7 +860,7 @@ void check_consolidation(const Problem& problem, std::vector<ProblemIssue>& issu
                       "section or remove output.consolidation"});
     return;
   }
-  const double end = problem.stages.empty() ? problem.time.end : problem.stages.back().end;
+  const double end = job_end_time(problem);
   if (!(c.from >= 0 && c.from < end))
     issues.push_back(
         {w / "from", "is " + format4(c.from) + " s; it must be in [0, " + format4(end) +

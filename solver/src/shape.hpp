@@ -12,9 +12,9 @@
 // times per particle per step.
 //
 // Stencils never leave the grid: at the grid boundary the first node is
-// clamped, and for the quadratic B-spline and GIMP the weight of the missing
-// ghost node is folded into the boundary node (a "clamped" B-spline), which
-// keeps the partition of unity and a zero sum of gradients.
+// clamped, and for the quadratic B-spline the weight of the missing ghost node
+// is folded into the boundary node (a "clamped" B-spline), which keeps the
+// partition of unity and a zero sum of gradients.
 #pragma once
 
 #include <Eigen/Core>
@@ -71,28 +71,10 @@ struct Gimp {
     // NOLINTNEXTLINE(bugprone-incorrect-roundings)
     return std::clamp(static_cast<int>(xi + 0.5) - 1, 0, cells - 2);
   }
-  /// At the grid boundary the weight of the missing node beyond it (a
-  /// particle domain, or a loaded face, reaching the grid's edge) is folded
-  /// into the boundary node, as the clamped B-spline does: the weights keep
-  /// their partition of unity and a load on a face at the edge arrives
-  /// whole (without the fold a traction on a face at the grid's edge lost
-  /// half_length / 4 of itself: 6 % with 2 particles per cell).
-  static inline void eval(double xi, int b, int cells, double half_length, int& base, double* w,
+  static inline void eval(double xi, int b, int /*cells*/, double half_length, int& base, double* w,
                           double* dw) {
     base = b;
     for (int k = 0; k < 3; ++k) weight(xi - (b + k), half_length, w[k], dw[k]);
-    if (b == 0) [[unlikely]] {
-      double s, ds;
-      weight(xi + 1.0, half_length, s, ds);  // the ghost node -1
-      w[0] += s;
-      dw[0] += ds;
-    }
-    if (b + 2 == cells) [[unlikely]] {
-      double s, ds;
-      weight(xi - (cells + 1), half_length, s, ds);  // the ghost node cells + 1
-      w[2] += s;
-      dw[2] += ds;
-    }
   }
 };
 

@@ -99,7 +99,7 @@ def main():
             failures.append(f"depth {depth:.3f} m: ratio {ratio[use][i]:.3f} against "
                             f"{exact[use][i]:.3f} at {f[use][i]:.3f} Hz")
         if depth < 0.05 * height:  # the surface particle: the resonance
-            band = (f > 0.5) & (f < 0.5 * (vs / (4 * height)) * 3)
+            band = (f > 0.5) & (f < 1.5 * vs / (4 * height))
             i, j = np.argmax(np.where(band, ratio, 0)), np.argmax(np.where(band, exact, 0))
             print(f"  first resonance: {f[i]:.4f} Hz (closed form {f[j]:.4f}, Vs/4H "
                   f"{vs / (4 * height):.4f}), amplification {ratio[i]:.3f} (closed form "

@@ -135,7 +135,7 @@ const char* name(hmpm::ShapeFunction s) {
 }
 
 // A pulse leaving a drained column through the absorbing base: what comes
-// back is at most 2 % of it (the bound; measured 1.3-1.6 % at 100
+// back is at most 2 % of it (the bound; measured 1.3-1.8 % at 100
 // cells, 0.4-0.6 % at 200, which also bounds the dispersion tail of the
 // incident pulse itself, counted here as "returned"), and no more at 200
 // cells than at 100. A fixed base sends it all back (the control: the
@@ -151,7 +151,7 @@ TEST(Absorbing, PulseLeavesADrainedColumnThroughTheBase) {
                 name(shape), coarse.returned, fine.returned);
     EXPECT_LT(coarse.returned, 0.02) << name(shape);
     EXPECT_LT(fine.returned, 0.02) << name(shape);
-    EXPECT_LE(fine.returned, coarse.returned * 1.05) << name(shape);
+    EXPECT_LT(fine.returned, coarse.returned) << name(shape);
     // The incident amplitude is the plane wave's q0 / (rho c).
     EXPECT_NEAR(coarse.incident, 1e4 / std::sqrt(rho_dry * e_oed), 0.08 * coarse.incident)
         << name(shape);

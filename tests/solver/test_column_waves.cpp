@@ -139,9 +139,9 @@ TEST(ColumnWaves, FiniteDifferenceReferenceConverges) {
 // and no larger than at 100 cells. Measured (100 -> 200 cells), Kf = 20
 // kPa: linear 2.2 % -> 0.87 %, GIMP 2.2 % -> 0.87 %, B-spline 3.5 % ->
 // 1.4 %; Kf = 200 kPa: 1.0 % -> 0.30 %, 1.0 % -> 0.30 %, 3.2 % -> 1.5 %.
-// (GIMP was 4.3 % -> 3.8 % before its stencil folded the ghost node beyond
-// the grid into the boundary node: the load on the top face, at the grid's
-// edge, arrived 6 % short.)
+// (GIMP was 4.3 % -> 3.8 % before a face load's weights were made whole at
+// the grid's edge: the load on the top face arrived 6 % short, its share of
+// the node beyond the grid lost; boundary/tractions.hpp, for_face_nodes.)
 TEST(ColumnWaves, ConvergeForEveryShapeFunctionNearAndFarFromTheDarcyInertiaLimit) {
   for (double kf : {20e3, 200e3})
     for (hmpm::ShapeFunction shape :

@@ -172,8 +172,7 @@ std::optional<FieldOfTime> read_acceleration(ParseContext& c, const json& j,
 }
 
 void integrate_accelerations(ParseContext& c) {
-  double end = c.p.time.end;
-  for (const Stage& s : c.p.stages) end = std::max(end, s.end);
+  const double end = job_end_time(c.p);
   if (!(end > 0)) return;
   for (const auto& a : c.accelerations) a->build(end);
 }

@@ -455,4 +455,10 @@ struct Problem {
   std::string first_stage_name = "initial";  ///< the top level's stage name
 };
 
+/// The time the whole job ends: the last stage's end (stages end in
+/// order, check_problem), else time.end.
+inline double job_end_time(const Problem& problem) {
+  return problem.stages.empty() ? problem.time.end : problem.stages.back().end;
+}
+
 }  // namespace hmpm

@@ -125,13 +125,14 @@ template <int Dim>
 double covered_face_share(const GridState<Dim>& grid, const ParticleState<Dim>& particles,
                           const std::vector<std::pair<std::int64_t, std::size_t>>& in_cell,
                           std::int64_t i, int normal) {
-  if (Dim == 1) return 1.0;
+  if constexpr (Dim == 1) return 1.0;
   constexpr int samples = 8;
   std::array<std::int64_t, Dim> q{};
-  double area = 1.0;
+  double area = 1.0, cell_volume = 1.0;
   std::array<double, Dim> lo{}, step{};
   for (int a = 0; a < Dim; ++a) {
     q[a] = (i / grid.stride[a]) % (grid.cells[a] + 1);
+    cell_volume *= grid.h[a];
     if (a == normal) continue;
     const double x = grid.origin[a] + static_cast<double>(q[a]) * grid.h[a];
     const double from = q[a] > 0 ? x - 0.5 * grid.h[a] : x;
@@ -140,8 +141,14 @@ double covered_face_share(const GridState<Dim>& grid, const ParticleState<Dim>& 
     lo[a] = from;
     step[a] = (to - from) / samples;
   }
-  // The particles in the cells that share node i.
-  std::vector<std::size_t> near;
+  // The particles in the cells that share node i, with their half extents:
+  // particles fill cells on a regular n x n (x n) pattern, n per axis from
+  // the particle's volume, so each spans h_a / n along axis a.
+  struct Near {
+    std::size_t p;
+    double per_axis;
+  };
+  std::vector<Near> near;
   for (int corner = 0; corner < (1 << Dim); ++corner) {
     std::int64_t cell = 0, stride = 1;
     bool inside = true;
@@ -155,7 +162,7 @@ double covered_face_share(const GridState<Dim>& grid, const ParticleState<Dim>& 
     const auto first = std::lower_bound(in_cell.begin(), in_cell.end(),
                                         std::pair<std::int64_t, std::size_t>{cell, 0});
     for (auto it = first; it != in_cell.end() && it->first == cell; ++it)
-      near.push_back(it->second);
+      near.push_back({it->second, std::pow(cell_volume / particles.volume[it->second], 1.0 / Dim)});
   }
   int covered = 0, total = 0;
   const int points = Dim == 2 ? samples : samples * samples;
@@ -168,21 +175,13 @@ double covered_face_share(const GridState<Dim>& grid, const ParticleState<Dim>& 
       rest /= samples;
     }
     ++total;
-    for (std::size_t p : near) {
-      // Particles fill cells on a regular n x n (x n) pattern: n from the
-      // particle's volume, its extent along axis a half of h_a / n each way.
-      double cell_volume = 1.0;
-      for (int a = 0; a < Dim; ++a) cell_volume *= grid.h[a];
-      const double per_axis = std::pow(cell_volume / particles.volume[p], 1.0 / Dim);
-      bool under = true;
+    const bool under = std::any_of(near.begin(), near.end(), [&](const Near& n) {
       for (int a = 0; a < Dim; ++a)
-        if (a != normal)
-          under = under && std::abs(s[a] - particles.x[p][a]) <= 0.5 * grid.h[a] / per_axis;
-      if (under) {
-        ++covered;
-        break;
-      }
-    }
+        if (a != normal && std::abs(s[a] - particles.x[n.p][a]) > 0.5 * grid.h[a] / n.per_axis)
+          return false;
+      return true;
+    });
+    if (under) ++covered;
   }
   return area * static_cast<double>(covered) / static_cast<double>(total);
 }
