@@ -52,8 +52,8 @@ namespace hmpm::checkpoint {
 inline constexpr char magic[8] = {'H', 'M', 'P', 'M', 'C', 'K', 'P', 'T'};
 /// 2: reactions; 3: plastic strain, profiles; 4: stages (the stage in
 /// force, the iterations of those before, particle ids); 5: consolidation;
-/// 6: absorbing boundaries' forces at rest
-inline constexpr std::uint32_t version = 6;
+/// 6: absorbing boundaries' forces at rest; 7: GIMP particles' box inverse
+inline constexpr std::uint32_t version = 7;
 
 /// FNV-1a, 64 bits, continuing from `h`.
 inline std::uint64_t fnv1a(const char* data, std::size_t n,

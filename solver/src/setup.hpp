@@ -103,9 +103,11 @@ void Simulation<Dim, Shape>::setup_particles() {
       particles_.material[p] = static_cast<std::uint16_t>(body.material);
       // GIMP half-length in cell units: of the sub-cell, or of the cube
       // of a points body's particle volume.
-      if (gimp)
-        particles_.half_length[p] =
-            body.points ? 0.5 * std::pow(v0 / cell_volume, 1.0 / Dim) : 0.5 / ppc;
+      if (gimp) {
+        const double lp = body.points ? 0.5 * std::pow(v0 / cell_volume, 1.0 / Dim) : 0.5 / ppc;
+        particles_.half_length[p] = std::max(lp, shape::Gimp::min_half_length);
+        particles_.box_inverse[p] = 0.5 / particles_.half_length[p];
+      }
       const InitialFields& init = body.initial;
       for (int a = 0; a < Dim; ++a)
         if (init.velocity[a]) particles_.v[p][a] = init.velocity[a](x3);

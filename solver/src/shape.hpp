@@ -3,9 +3,10 @@
 // Each shape function is a small struct with a compile-time stencil width K
 // (nodes per axis), a `locate` that, for a particle coordinate expressed in
 // cell units along one axis, returns the cell its stencil is anchored to,
-// and an `eval` that, given that cell, returns the first node of the stencil
-// and the K weights and derivatives (per cell unit). The tensor product over
-// axes is formed by `Stencil`. Locating (a truncation, a clamp, an integer
+// and an `eval` (K = 2) or `eval_lanes` (K = 3, the K weights in one
+// four-lane vector) that, given that cell, returns the first node of the
+// stencil and the K weights and derivatives (per cell unit). The tensor
+// product over axes is formed by `Stencil`. Locating (a truncation, a clamp, an integer
 // conversion per axis) is about a third of a stencil's cost; the time step
 // locates once per step and reuses the cells while particles do not move.
 // Everything is inline, branch-light and allocation-free: it runs several
@@ -22,8 +23,41 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 
 namespace hmpm::shape {
+
+/// Four doubles, one AVX register (two SSE registers without AVX): the
+/// GCC/Clang vector extension, so the 3-node shape functions evaluate all
+/// the nodes of an axis at once, and the tensor product forms a whole row of
+/// the stencil per instruction (lane 3 is padding).
+using Lanes = double __attribute__((vector_size(32)));
+
+inline Lanes lanes_max(Lanes a, Lanes b) {
+  return a < b ? b : a;
+}
+inline Lanes lanes_min(Lanes a, Lanes b) {
+  return b < a ? b : a;
+}
+/// Stores the four lanes at `to` (which has room for them).
+inline void store_lanes(double* to, Lanes v) {
+  std::memcpy(to, &v, sizeof v);
+}
+
+/// A GIMP particle's box in cell units: its half-length and the reciprocal
+/// of its length (kept per particle: the stencil multiplies by it). Zero
+/// for the other shape functions.
+struct Box {
+  double half_length = 0.0;
+  double inverse = 0.0;  ///< 1 / (2 half_length)
+};
+
+/// Particle p's box, from a ParticleState (state/particles.hpp).
+template <class Particles>
+inline Box box_of(const Particles& particles, std::size_t p) {
+  if (particles.half_length.empty()) return {};
+  return {particles.half_length[p], particles.box_inverse[p]};
+}
 
 /// Linear hat functions: 2 nodes per axis.
 struct Linear {
@@ -32,8 +66,8 @@ struct Linear {
     // Particles are inside the grid (xi >= 0), so truncation is floor.
     return std::clamp(static_cast<int>(xi), 0, cells - 1);
   }
-  static inline void eval(double xi, int b, int /*cells*/, double /*half_length*/, int& base,
-                          double* w, double* dw) {
+  static inline void eval(double xi, int b, int /*cells*/, Box /*box*/, int& base, double* w,
+                          double* dw) {
     const double f = xi - b;
     base = b;
     w[0] = 1.0 - f;
@@ -46,35 +80,38 @@ struct Linear {
 /// Uniform GIMP (Bardenhagen & Kober 2004): the particle is a box of
 /// half-length `half_length` (cell units) convolved with the hat function.
 /// 3 nodes per axis.
+///
+/// Branch-free and vectorised over the three nodes: the convolution is the
+/// difference of the hat's antiderivative H at the box's two ends, divided
+/// by the box's length, and H on the clamped argument c in [-1, 1] is one
+/// polynomial, H(c) = 1/2 + c - c|c|/2 (0 left of the hat, 1 right of it);
+/// the derivative is the difference of the hat's values, 1 - |c|. (The
+/// piecewise form, four cases per node, compiled to six unpredictable
+/// branches per axis.)
 struct Gimp {
   static constexpr int K = 3;
-  static inline void weight(double d, double lp, double& s, double& ds) {
-    const double a = std::abs(d);
-    const double sg = d < 0 ? -1.0 : 1.0;
-    if (a < lp) {
-      s = 1.0 - (d * d + lp * lp) / (2.0 * lp);
-      ds = -d / lp;
-    } else if (a < 1.0 - lp) {
-      s = 1.0 - a;
-      ds = -sg;
-    } else if (a < 1.0 + lp) {
-      const double r = 1.0 + lp - a;
-      s = r * r / (4.0 * lp);
-      ds = -sg * r / (2.0 * lp);
-    } else {
-      s = 0.0;
-      ds = 0.0;
-    }
-  }
+  /// Smallest half-length used (cell units): a points body's particle may
+  /// be tiny, and 1/half_length multiplies a difference of O(1) values.
+  static constexpr double min_half_length = 1e-4;
   static inline int locate(double xi, int cells) {
     // xi >= 0 inside the grid, so truncating xi + 0.5 rounds (no lround call in the hot loop).
     // NOLINTNEXTLINE(bugprone-incorrect-roundings)
     return std::clamp(static_cast<int>(xi + 0.5) - 1, 0, cells - 2);
   }
-  static inline void eval(double xi, int b, int /*cells*/, double half_length, int& base, double* w,
-                          double* dw) {
+  /// Weights (lanes 0..2) and derivatives per cell unit of nodes b, b+1, b+2.
+  /// The box's half-length is at least min_half_length (setup.hpp).
+  static inline void eval_lanes(double xi, int b, int /*cells*/, Box box, int& base, Lanes& w,
+                                Lanes& dw) {
     base = b;
-    for (int k = 0; k < 3; ++k) weight(xi - (b + k), half_length, w[k], dw[k]);
+    const double lp = box.half_length, inv = box.inverse;
+    const Lanes node = {0.0, 1.0, 2.0, 3.0};
+    const Lanes d = (xi - b) - node;  // particle minus node, cell units
+    const Lanes one = {1.0, 1.0, 1.0, 1.0};
+    const Lanes hi = lanes_min(lanes_max(d + lp, -one), one);
+    const Lanes lo = lanes_min(lanes_max(d - lp, -one), one);
+    const Lanes ahi = lanes_max(hi, -hi), alo = lanes_max(lo, -lo);
+    w = ((hi - lo) - 0.5 * (hi * ahi - lo * alo)) * inv;
+    dw = (alo - ahi) * inv;
   }
 };
 
@@ -86,36 +123,29 @@ struct BSpline {
   static inline int locate(double xi, int /*cells*/) {
     return static_cast<int>(std::floor(xi - 0.5));
   }
-  static inline void eval(double xi, int b, int cells, double /*half_length*/, int& base, double* w,
-                          double* dw) {
-    const double f = xi - b;  // in [0.5, 1.5)
-    double w0 = 0.5 * (1.5 - f) * (1.5 - f), w1 = 0.75 - (f - 1.0) * (f - 1.0),
-           w2 = 0.5 * (f - 0.5) * (f - 0.5);
-    double d0 = -(1.5 - f), d1 = -2.0 * (f - 1.0), d2 = f - 0.5;
-    if (b < 0) {  // ghost node -1 folded into node 0
+  /// Weights (lanes 0..2) and derivatives per cell unit of nodes base..base+2.
+  /// With f = xi - b in [0.5, 1.5) and t = (1.5 - f, f - 1, f - 0.5) (each
+  /// lane one exact sign flip and one subtraction):
+  /// w = (0.5 t0^2, 0.75 - t1^2, 0.5 t2^2), dw = (-t0, -2 t1, t2).
+  static inline void eval_lanes(double xi, int b, int cells, Box /*box*/, int& base, Lanes& w,
+                                Lanes& dw) {
+    const double f = xi - b;
+    const Lanes sign = {-1.0, 1.0, 1.0, 0.0}, shift = {1.5, -1.0, -0.5, 0.0};
+    const Lanes square = {0.5, -1.0, 0.5, 0.0}, constant = {0.0, 0.75, 0.0, 0.0};
+    const Lanes slope = {-1.0, -2.0, 1.0, 0.0};
+    const Lanes t = shift + sign * f;
+    w = square * t * t + constant;
+    dw = slope * t;
+    if (b < 0) [[unlikely]] {  // ghost node -1 folded into node 0
       base = 0;
-      w[0] = w0 + w1;
-      w[1] = w2;
-      w[2] = 0.0;
-      dw[0] = d0 + d1;
-      dw[1] = d2;
-      dw[2] = 0.0;
-    } else if (b + 2 > cells) {  // ghost node cells+1 folded into node cells
+      w = Lanes{w[0] + w[1], w[2], 0.0, 0.0};
+      dw = Lanes{dw[0] + dw[1], dw[2], 0.0, 0.0};
+    } else if (b + 2 > cells) [[unlikely]] {  // ghost node cells+1 folded into node cells
       base = cells - 2;
-      w[0] = 0.0;
-      w[1] = w0;
-      w[2] = w1 + w2;
-      dw[0] = 0.0;
-      dw[1] = d0;
-      dw[2] = d1 + d2;
+      w = Lanes{0.0, w[0], w[1] + w[2], 0.0};
+      dw = Lanes{0.0, dw[0], dw[1] + dw[2], 0.0};
     } else {
       base = b;
-      w[0] = w0;
-      w[1] = w1;
-      w[2] = w2;
-      dw[0] = d0;
-      dw[1] = d1;
-      dw[2] = d2;
     }
   }
 };
@@ -126,12 +156,14 @@ template <int Dim, class Shape>
 struct Stencil {
   static constexpr int K = Shape::K;
   static constexpr int N = Dim == 1 ? K : (Dim == 2 ? K * K : K * K * K);
+  /// Room for the last row's four-lane store (3-node shape functions).
+  static constexpr int Room = K == 3 ? N + 1 : N;
   std::array<std::int64_t, N> node{};
-  std::array<double, N> w{};
+  std::array<double, Room> w{};
   /// dN/dx_a of the N nodes, one array per axis (structure of arrays, so the
   /// products below vectorise across nodes). Zeroed once per phase (not per
   /// particle): weights-only passes leave them untouched.
-  std::array<std::array<double, N>, Dim> dw{};
+  std::array<std::array<double, Room>, Dim> dw{};
 
   /// Gradient of node k's shape function.
   Eigen::Matrix<double, Dim, 1> grad(int k) const {
@@ -145,23 +177,38 @@ struct Stencil {
   /// interpolate values but not gradients).
   template <bool Grad = true, class Vec>
   inline void compute(const Vec& x, const double* origin, const double* inv_h, const int* cells,
-                      const std::int64_t* stride, double half_length) {
+                      const std::int64_t* stride, Box box) {
     std::int32_t cell[Dim];
-    compute<Grad, false>(x, origin, inv_h, cells, stride, half_length, cell);
+    compute<Grad, false>(x, origin, inv_h, cells, stride, box, cell);
   }
 
   /// As compute; Located = false also stores each axis's cell (Shape::locate)
   /// in `cell`, Located = true takes them from there (the same x, so the
   /// same cells: a particle located earlier in the step).
   template <bool Grad, bool Located, class Vec>
-  inline void compute(const Vec& x, const double* origin, const double* inv_h, const int* cells,
-                      const std::int64_t* stride, double half_length, std::int32_t* cell) {
+  __attribute__((always_inline)) inline void compute(const Vec& x, const double* origin,
+                                                     const double* inv_h, const int* cells,
+                                                     const std::int64_t* stride, Box box,
+                                                     std::int32_t* cell) {
+    if constexpr (K == 3)
+      compute_lanes<Grad, Located>(x, origin, inv_h, cells, stride, box, cell);
+    else
+      compute_scalar<Grad, Located>(x, origin, inv_h, cells, stride, box, cell);
+  }
+
+ private:
+  /// 2-node (linear) stencils, one node at a time.
+  template <bool Grad, bool Located, class Vec>
+  __attribute__((always_inline)) inline void compute_scalar(const Vec& x, const double* origin,
+                                                            const double* inv_h, const int* cells,
+                                                            const std::int64_t* stride, Box box,
+                                                            std::int32_t* cell) {
     int base[Dim];
     double wa[Dim][K], da[Dim][K];
     for (int a = 0; a < Dim; ++a) {
       const double xi = (x[a] - origin[a]) * inv_h[a];
       if constexpr (!Located) cell[a] = Shape::locate(xi, cells[a]);
-      Shape::eval(xi, cell[a], cells[a], half_length, base[a], wa[a], da[a]);
+      Shape::eval(xi, cell[a], cells[a], box, base[a], wa[a], da[a]);
       if constexpr (Grad)
         for (int k = 0; k < K; ++k) da[a][k] *= inv_h[a];
     }
@@ -202,6 +249,59 @@ struct Stencil {
               dw[1][n] = wa[0][i] * djk;
               dw[2][n] = wa[0][i] * wdk;
             }
+          }
+        }
+    }
+  }
+
+  /// 3-node (GIMP, B-spline) stencils: each axis's three weights in one
+  /// vector, and each row of the tensor product (three nodes along axis 0)
+  /// one vector product and one four-lane store (the next row's store
+  /// overwrites the padding lane; the last one lands in the spare element).
+  /// The products are those of compute_scalar, in the same order.
+  template <bool Grad, bool Located, class Vec>
+  __attribute__((always_inline)) inline void compute_lanes(const Vec& x, const double* origin,
+                                                           const double* inv_h, const int* cells,
+                                                           const std::int64_t* stride, Box box,
+                                                           std::int32_t* cell) {
+    int base[Dim];
+    Lanes wa[Dim], da[Dim];
+    for (int a = 0; a < Dim; ++a) {
+      const double xi = (x[a] - origin[a]) * inv_h[a];
+      if constexpr (!Located) cell[a] = Shape::locate(xi, cells[a]);
+      Shape::eval_lanes(xi, cell[a], cells[a], box, base[a], wa[a], da[a]);
+      if constexpr (Grad) da[a] *= inv_h[a];
+    }
+    if constexpr (Dim == 1) {
+      for (int i = 0; i < K; ++i) node[i] = base[0] + i;
+      store_lanes(w.data(), wa[0]);
+      if constexpr (Grad) store_lanes(dw[0].data(), da[0]);
+    } else if constexpr (Dim == 2) {
+      const std::int64_t node0 = base[0] + base[1] * stride[1];
+      for (int j = 0; j < K; ++j) {
+        const std::int64_t row = node0 + j * stride[1];
+        for (int i = 0; i < K; ++i) node[K * j + i] = row + i;
+        store_lanes(w.data() + K * j, wa[0] * wa[1][j]);
+        if constexpr (Grad) {
+          store_lanes(dw[0].data() + K * j, da[0] * wa[1][j]);
+          store_lanes(dw[1].data() + K * j, wa[0] * da[1][j]);
+        }
+      }
+    } else {
+      const std::int64_t node0 = base[0] + base[1] * stride[1] + base[2] * stride[2];
+      for (int k = 0; k < K; ++k)
+        for (int j = 0; j < K; ++j) {
+          const int n = K * (j + K * k);
+          const std::int64_t row = node0 + j * stride[1] + k * stride[2];
+          for (int i = 0; i < K; ++i) node[n + i] = row + i;
+          const double wjk = wa[1][j] * wa[2][k];
+          store_lanes(w.data() + n, wa[0] * wjk);
+          if constexpr (Grad) {
+            const double djk = da[1][j] * wa[2][k];
+            const double wdk = wa[1][j] * da[2][k];
+            store_lanes(dw[0].data() + n, da[0] * wjk);
+            store_lanes(dw[1].data() + n, wa[0] * djk);
+            store_lanes(dw[2].data() + n, wa[0] * wdk);
           }
         }
     }

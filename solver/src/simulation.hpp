@@ -214,18 +214,19 @@ class Simulation {
   template <bool Grad = true>
   inline void stencil_of(std::size_t p, StencilT& s) const {
     s.template compute<Grad>(particles_.x[p], grid_.origin, grid_.inv_h, grid_.cells, grid_.stride,
-                             particles_.half_length.empty() ? 0.0 : particles_.half_length[p]);
+                             box_of(p));
   }
 
   /// In the step: the first phase locates each particle's stencil (and
   /// records the cells), the later phases, before particles move, reuse them.
   template <bool Grad, bool Located>
-  inline void stencil_in_step(std::size_t p, StencilT& s) {
-    s.template compute<Grad, Located>(
-        particles_.x[p], grid_.origin, grid_.inv_h, grid_.cells, grid_.stride,
-        particles_.half_length.empty() ? 0.0 : particles_.half_length[p],
-        particles_.cell[p].data());
+  __attribute__((always_inline)) inline void stencil_in_step(std::size_t p, StencilT& s) {
+    s.template compute<Grad, Located>(particles_.x[p], grid_.origin, grid_.inv_h, grid_.cells,
+                                      grid_.stride, box_of(p), particles_.cell[p].data());
   }
+
+  /// Particle p's GIMP box (zero for the other shape functions).
+  inline shape::Box box_of(std::size_t p) const { return shape::box_of(particles_, p); }
 
   // ------------------------------------------------------------ failures (failures.hpp)
   // Called from hot loops only on the failure path. Threads may find

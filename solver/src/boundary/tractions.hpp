@@ -133,7 +133,7 @@ inline void for_face_nodes(const FaceParticles& face, std::size_t k,
   VecD<Dim> at = particles.x[p];
   at[face.axis] += face.side * 0.5 * face.length0[k] * stretch;
   s.template compute<false>(at, grid.origin, grid.inv_h, grid.cells, grid.stride,
-                            particles.half_length.empty() ? 0.0 : particles.half_length[p]);
+                            shape::box_of(particles, p));
   // GIMP at a face on the grid's edge: the particle-sized stencil there
   // reaches a node beyond the grid, whose share (half_length / 4 of the load:
   // 6 % with 2 particles per cell) goes to the nodes inside. The other

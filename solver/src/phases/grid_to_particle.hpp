@@ -17,13 +17,16 @@ inline void Simulation<Dim, Shape>::update_particle_velocities_and_remap(const O
                                                                          std::size_t end,
                                                                          double dt) {
   StencilT s;
+  // A local copy: the compiler otherwise reloads the pointer at every node
+  // (Eigen's vector stores may alias it).
+  Vec* const remap_out = at<nodal::remap>(out);
   for (std::size_t p = begin; p < end; ++p) {
     stencil_in_step<false, true>(p, s);
     Vec a = Vec::Zero();
     for (int k = 0; k < StencilT::N; ++k) a += s.w[k] * grid_.accel[s.node[k]];
     particles_.v[p] += dt * a;
     const Vec mv = particles_.mass[p] * particles_.v[p];
-    for (int k = 0; k < StencilT::N; ++k) at<nodal::remap>(out)[s.node[k]] += s.w[k] * mv;
+    for (int k = 0; k < StencilT::N; ++k) remap_out[s.node[k]] += s.w[k] * mv;
   }
 }
 

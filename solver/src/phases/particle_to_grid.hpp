@@ -52,12 +52,20 @@ inline void Simulation<Dim, Shape>::map_particles_to_grid(const Out& out, std::s
     const double vol = particles_.volume[p];
     const Vec mv = m * particles_.v[p];
     const Mat vol_sig = vol * active_stress(particles_.stress[p]);
-    for (int k = 0; k < StencilT::N; ++k) {
-      const std::int64_t i = s.node[k];
-      const double w = s.w[k];
-      mass_out[i] += w * m;
-      momentum_out[i] += w * mv;
-      force_out[i].noalias() -= vol_sig * s.grad(k);
+    // Row by row (K consecutive nodes along axis 0): the addresses of a row's
+    // nodes are one base plus constants, not an index computation per node
+    // and array. The same sums in the same order as node by node.
+    for (int r = 0; r < StencilT::N; r += StencilT::K) {
+      const std::int64_t row = s.node[r];
+      double* const mass_row = mass_out + row;
+      Vec* const momentum_row = momentum_out + row;
+      Vec* const force_row = force_out + row;
+      for (int i = 0; i < StencilT::K; ++i) {
+        const double w = s.w[r + i];
+        mass_row[i] += w * m;
+        momentum_row[i] += w * mv;
+        force_row[i].noalias() -= vol_sig * s.grad(r + i);
+      }
     }
     if (fluid_) {
       const std::uint16_t mat = particles_.material[p];
