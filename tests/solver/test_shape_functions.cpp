@@ -59,7 +59,9 @@ Ref bspline_reference(double d) {
   return {0.0, 0.0};
 }
 
-Box box(double lp) { return {lp, 0.5 / lp}; }
+Box box(double lp) {
+  return {lp, 0.5 / lp};
+}
 
 /// A 1D stencil of a particle at xi (cell units) in a grid of `cells` cells
 /// of unit size.
@@ -177,7 +179,8 @@ void expect_tensor_product(Box b) {
   double inv_h[3];
   for (int a = 0; a < 3; ++a) inv_h[a] = 1.0 / h[a];
   const std::int64_t stride[3] = {1, cells[0] + 1, std::int64_t{cells[0] + 1} * (cells[1] + 1)};
-  const double where[4][3] = {{0.3, 0.6, 0.1}, {2.77, 4.1, 3.3}, {6.9, 8.95, 5.999}, {3.5, 4.5, 2.5}};
+  const double where[4][3] = {
+      {0.3, 0.6, 0.1}, {2.77, 4.1, 3.3}, {6.9, 8.95, 5.999}, {3.5, 4.5, 2.5}};
   for (const auto& xi : where) {
     Eigen::Matrix<double, Dim, 1> x;
     for (int a = 0; a < Dim; ++a) x[a] = origin[a] + xi[a] * h[a];
@@ -201,8 +204,7 @@ void expect_tensor_product(Box b) {
           EXPECT_NEAR(s.w[n], w, round_off);
           for (int g = 0; g < Dim; ++g) {
             double dw = inv_h[g];
-            for (int a = 0; a < Dim; ++a)
-              dw *= a == g ? axis[a].dw[0][idx[a]] : axis[a].w[idx[a]];
+            for (int a = 0; a < Dim; ++a) dw *= a == g ? axis[a].dw[0][idx[a]] : axis[a].w[idx[a]];
             EXPECT_NEAR(s.dw[g][n], dw, round_off * inv_h[g]);
           }
         }
