@@ -24,6 +24,9 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#ifdef __AVX__
+#include <immintrin.h>
+#endif
 
 namespace hmpm::shape {
 
@@ -33,12 +36,23 @@ namespace hmpm::shape {
 /// the stencil per instruction (lane 3 is padding).
 using Lanes = double __attribute__((vector_size(32)));
 
+#ifdef __AVX__
+// vmaxpd/vminpd (GCC otherwise compiles the clamps below to a compare and a
+// blend); the operand order gives the ternaries' result for NaN as well.
+inline Lanes lanes_max(Lanes a, Lanes b) {
+  return _mm256_max_pd(b, a);
+}
+inline Lanes lanes_min(Lanes a, Lanes b) {
+  return _mm256_min_pd(b, a);
+}
+#else
 inline Lanes lanes_max(Lanes a, Lanes b) {
   return a < b ? b : a;
 }
 inline Lanes lanes_min(Lanes a, Lanes b) {
   return b < a ? b : a;
 }
+#endif
 /// Stores the four lanes at `to` (which has room for them).
 inline void store_lanes(double* to, Lanes v) {
   std::memcpy(to, &v, sizeof v);
