@@ -541,6 +541,26 @@ void check_body_shape(const Problem& problem, const Body& body, const Location& 
                                                     "); particles must start inside it"});
         ++reported;
       }
+    // GIMP's stencil holds 3 nodes per axis: a particle box wider than a
+    // cell (half-length above half a cell) reaches a fourth node, whose
+    // share of the particle's mass and forces would be lost.
+    if (problem.shape_function == ShapeFunction::gimp) {
+      double cell_volume = 1.0;
+      for (int a = 0; a < problem.dimension; ++a) cell_volume *= cell_size(problem, a);
+      reported = 0;
+      for (std::size_t k = 0; k < pl.volumes.size() && reported < 10; ++k)
+        if (pl.volumes[k] > cell_volume * (1.0 + 1e-9)) {
+          std::string message = "is " + format4(pl.volumes[k]);
+          message += ", more than one cell (";
+          message += format4(cell_volume);
+          message +=
+              "): with shape_function gimp a particle's box must fit in a cell, or part of "
+              "its mass reaches nodes beyond the stencil and is lost; split it into smaller "
+              "particles, use larger cells, or use shape_function bspline";
+          issues.push_back({wp / "volumes" / k, std::move(message)});
+          ++reported;
+        }
+    }
   }
 }
 

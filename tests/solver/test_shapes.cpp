@@ -291,6 +291,28 @@ TEST(PointsBody, ChecksLengthsVolumesAndTheGrid) {
                                              "bodies/0/points/positions/1"}));
 }
 
+TEST(PointsBody, GimpRefusesParticlesLargerThanACell) {
+  // Cells of 0.5 m x 0.5 m: a particle of 0.25 m^2 fills one exactly (its
+  // box's half-length is half a cell, the most GIMP's 3-node stencil holds);
+  // 0.3 m^2 would reach a fourth node and lose that share of its mass.
+  hmpm::Problem p = ground(20, 8);
+  hmpm::Body b;
+  b.points = hmpm::ParticleList{{{1, 1, 0}, {3, 1, 0}, {5, 1, 0}}, {0.25, 0.3, 0.1}};
+  p.bodies.push_back(b);
+  for (auto shape : {hmpm::ShapeFunction::linear, hmpm::ShapeFunction::bspline})
+    EXPECT_TRUE(hmpm::check_problem([&] {
+                  hmpm::Problem q = p;
+                  q.shape_function = shape;
+                  return q;
+                }())
+                    .empty());
+  p.shape_function = hmpm::ShapeFunction::gimp;
+  const auto issues = hmpm::check_problem(p);
+  ASSERT_EQ(issues.size(), 1u);
+  EXPECT_EQ(issues[0].where.text(), "bodies/0/points/volumes/1");
+  EXPECT_NE(issues[0].message.find("bspline"), std::string::npos) << issues[0].message;
+}
+
 TEST(PrismBody, MassIsDensityTimesAreaTimesLength) {
   // A trapezoid extruded along z over [0.5, 2.5] (cell faces, so the length
   // is exact), and the same polygon in the (y, z) plane extruded along x.
