@@ -119,6 +119,8 @@ class Simulation {
   void update_particle_pressure_and_position(std::size_t begin, std::size_t end, double dt);
   __attribute__((always_inline)) inline void move_particle(std::size_t p, const StencilT& s,
                                                            double dt);
+  /// move_particle's second half: x += dt v, v = sum N_i v_i gathered by the caller.
+  __attribute__((always_inline)) inline void displace_particle(std::size_t p, Vec v, double dt);
   static Mat active_stress(const Voigt& s);
 
   // ------------------------------------------------------------ pressure projection

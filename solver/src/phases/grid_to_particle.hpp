@@ -39,9 +39,16 @@ template <int Dim, class Shape>
 __attribute__((always_inline)) inline void Simulation<Dim, Shape>::move_particle(std::size_t p,
                                                                                  const StencilT& s,
                                                                                  double dt) {
-  Vec dx = Vec::Zero();
-  for (int k = 0; k < StencilT::N; ++k) dx += s.w[k] * grid_.velocity[s.node[k]];
-  dx *= dt;
+  Vec v = Vec::Zero();
+  for (int k = 0; k < StencilT::N; ++k) v += s.w[k] * grid_.velocity[s.node[k]];
+  displace_particle(p, v, dt);
+}
+
+template <int Dim, class Shape>
+__attribute__((always_inline)) inline void Simulation<Dim, Shape>::displace_particle(std::size_t p,
+                                                                                     Vec v,
+                                                                                     double dt) {
+  const Vec dx = v * dt;
   Vec& x = particles_.x[p];
   x += dx;
   // Branch-free: one test per axis, which a NaN position also fails.

@@ -30,8 +30,14 @@ inline void Simulation<Dim, Shape>::update_particle_stress_and_fluid_flux(const 
   for (std::size_t p = begin; p < end; ++p) {
     stencil_in_step<true, true>(p, s);
     Mat grad_v = Mat::Zero();
-    for (int k = 0; k < StencilT::N; ++k)
+    // Dry runs move the particle in this phase: its velocity is gathered
+    // from the same nodes in the same loop (the same sums, in the same order,
+    // as move_particle's).
+    Vec v_move = Vec::Zero();
+    for (int k = 0; k < StencilT::N; ++k) {
       grad_v.noalias() += grid_.remap[s.node[k]] * s.grad(k).transpose();
+      if constexpr (!Fluid) v_move += s.w[k] * grid_.velocity[s.node[k]];
+    }
     const double vol = particles_.volume[p];
     const std::uint16_t mat = particles_.material[p];
     const MaterialConstants& mc = constants_[mat];
@@ -85,7 +91,7 @@ inline void Simulation<Dim, Shape>::update_particle_stress_and_fluid_flux(const 
     if (!(j > 0.0)) fail_volume(p, j);
     particles_.volume[p] = vol * j;
     if (Fluid && mc.saturated) particles_.porosity[p] = 1.0 - (1.0 - particles_.porosity[p]) / j;
-    if constexpr (!Fluid) move_particle(p, s, dt);
+    if constexpr (!Fluid) displace_particle(p, v_move, dt);
   }
 }
 
