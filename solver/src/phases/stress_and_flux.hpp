@@ -27,6 +27,8 @@ inline void Simulation<Dim, Shape>::update_particle_stress_and_fluid_flux(const 
                                                                           std::size_t end,
                                                                           double dt) {
   StencilT s;
+  // A local copy (Eigen's stores may alias the pointer for the compiler).
+  double* const flux_out = Fluid && ScatterFlux ? at<nodal::flux>(out) : nullptr;
   for (std::size_t p = begin; p < end; ++p) {
     stencil_in_step<true, true>(p, s);
     Mat grad_v = Mat::Zero();
@@ -56,7 +58,7 @@ inline void Simulation<Dim, Shape>::update_particle_stress_and_fluid_flux(const 
       particles_.darcy[p] = w;
       if constexpr (ScatterFlux)
         for (int k = 0; k < StencilT::N; ++k)
-          at<nodal::flux>(out)[s.node[k]] += vol * (s.grad(k).dot(w) - s.w[k] * div_v);
+          flux_out[s.node[k]] += vol * (s.grad(k).dot(w) - s.w[k] * div_v);
     }
     Voigt de = Voigt::Zero();
     for (int a = 0; a < Dim; ++a) de[a] = grad_v(a, a) * dt;
