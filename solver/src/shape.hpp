@@ -170,14 +170,14 @@ template <int Dim, class Shape>
 struct Stencil {
   static constexpr int K = Shape::K;
   static constexpr int N = Dim == 1 ? K : (Dim == 2 ? K * K : K * K * K);
-  /// Room for the last row's four-lane store (3-node shape functions).
-  static constexpr int Room = K == 3 ? N + 1 : N;
+  /// Elements per array: room for the last row's four-lane store (3-node shape functions).
+  static constexpr int room = K == 3 ? N + 1 : N;
   std::array<std::int64_t, N> node{};
-  std::array<double, Room> w{};
+  std::array<double, room> w{};
   /// dN/dx_a of the N nodes, one array per axis (structure of arrays, so the
   /// products below vectorise across nodes). Zeroed once per phase (not per
   /// particle): weights-only passes leave them untouched.
-  std::array<std::array<double, Room>, Dim> dw{};
+  std::array<std::array<double, room>, Dim> dw{};
 
   /// Gradient of node k's shape function.
   Eigen::Matrix<double, Dim, 1> grad(int k) const {
