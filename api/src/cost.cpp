@@ -250,7 +250,7 @@ double memory_bytes(const Problem& p, const CostEstimate& c, double threads) {
   });
   // x, x0, v; mass, volume; stress, strain (Voigt); material, cell.
   double particle = 8 * (3 * d + 2 + 12) + 2 + 4 * d;
-  if (p.shape_function == ShapeFunction::gimp) particle += 8;
+  if (p.shape_function == ShapeFunction::gimp) particle += 16;  // half_length, box_inverse
   if (fluid) particle += 8 * (3 + d);  // pressure, pressure_out, porosity, darcy
   if (plastic) particle += 8 * MemoryModel::plastic_state_variables;
   // Scattered sums (mass, momentum, force, remap; storage, pressure, flux)
