@@ -42,6 +42,13 @@ double cell_size(const Problem& problem, int a) {
   return (problem.grid.max[a] - problem.grid.min[a]) / problem.grid.cells[a];
 }
 
+/// Volume of one cell (area in 2D, length in 1D).
+double cell_volume(const Problem& problem) {
+  double v = 1.0;
+  for (int a = 0; a < problem.dimension; ++a) v *= cell_size(problem, a);
+  return v;
+}
+
 /// Tolerance of "on the boundary" for filling: far below any sub-cell spacing.
 double fill_tolerance(const Problem& problem) {
   return 1e-9 * min_cell_size(problem);
@@ -149,8 +156,7 @@ std::vector<BodyLayout> body_layouts(const Problem& problem, LayoutDetail detail
   std::vector<std::vector<Vec3>> sorted_points(problem.bodies.size());
   std::vector<Box> bounds;
   for (const Body& body : problem.bodies) bounds.push_back(shape_box(body));
-  double cell_volume = 1.0;
-  for (int a = 0; a < dim; ++a) cell_volume *= cell_size(problem, a);
+  const double cell_v = cell_volume(problem);
   for (std::size_t b = 0; b < problem.bodies.size(); ++b) {
     const Body& body = problem.bodies[b];
     BodyLayout& layout = layouts[b];
@@ -202,7 +208,7 @@ std::vector<BodyLayout> body_layouts(const Problem& problem, LayoutDetail detail
     } else {
       const std::array<std::vector<double>, 3> coords = lattice_coords(problem, body);
       const bool shaped = body.polygon || body.prism;
-      const double v0 = cell_volume / std::pow(std::max(body.particles_per_cell, 1), dim);
+      const double v0 = cell_v / std::pow(std::max(body.particles_per_cell, 1), dim);
       if (store) {
         const std::size_t most = coords[0].size() * coords[1].size() * coords[2].size();
         layout.positions.reserve(most);
@@ -545,14 +551,13 @@ void check_body_shape(const Problem& problem, const Body& body, const Location& 
     // cell (half-length above half a cell) reaches a fourth node, whose
     // share of the particle's mass and forces would be lost.
     if (problem.shape_function == ShapeFunction::gimp) {
-      double cell_volume = 1.0;
-      for (int a = 0; a < problem.dimension; ++a) cell_volume *= cell_size(problem, a);
+      const double cell_v = cell_volume(problem);
       reported = 0;
       for (std::size_t k = 0; k < pl.volumes.size() && reported < 10; ++k)
-        if (pl.volumes[k] > cell_volume * (1.0 + 1e-9)) {
+        if (pl.volumes[k] > cell_v * (1.0 + 1e-9)) {
           std::string message = "is " + format4(pl.volumes[k]);
           message += ", more than one cell (";
-          message += format4(cell_volume);
+          message += format4(cell_v);
           message +=
               "): with shape_function gimp a particle's box must fit in a cell, or part of "
               "its mass reaches nodes beyond the stencil and is lost; split it into smaller "
