@@ -121,6 +121,8 @@ class Simulation {
                                                            double dt);
   /// move_particle's second half: x += dt v, v = sum N_i v_i gathered by the caller.
   __attribute__((always_inline)) inline void displace_particle(std::size_t p, Vec v, double dt);
+  /// A particle outside the grid: back onto the face if a wall holds it there.
+  bool return_to_wall(std::size_t p);
   static Mat active_stress(const Voigt& s);
 
   // ------------------------------------------------------------ pressure projection

@@ -98,8 +98,9 @@ struct Constraints {
   std::vector<PressureConstraint> pressure;
   std::vector<SeepageFace> seepage;
   std::vector<AbsorbingConstraint> absorbing;
-  /// Per node (saturated runs): bit a set when a boundary prescribes or ties
-  /// component a. Empty in dry runs.
+  /// Per node: bit a set when a boundary prescribes or ties component a
+  /// (the Darcy term's accelerations, phases/grid.hpp; walls that keep
+  /// particles in the grid, phases/grid_to_particle.hpp).
   std::vector<std::uint8_t> prescribed_axes;
 };
 
@@ -289,8 +290,7 @@ Constraints compile_constraints(const Problem& problem, const GridState<Dim>& gr
       c.pressure.push_back(std::move(pc));
     }
   }
-  if (!fluid) return c;
-  if (!c.seepage.empty()) {
+  if (fluid && !c.seepage.empty()) {
     std::vector<std::uint8_t> prescribed(static_cast<std::size_t>(grid.count), 0);
     for (const PressureConstraint& bc : c.pressure)
       for (std::int64_t i : bc.nodes) prescribed[static_cast<std::size_t>(i)] = 1;
