@@ -343,7 +343,7 @@ TEST(Walls, ParticlesOnAFloorStayInTheGrid) {
   opt.on_snapshot = [&](const hmpm::Snapshot& s) { last = s.position; };
   const hmpm::RunResult r = hmpm::run(p, opt);
   ASSERT_EQ(r.status, hmpm::RunStatus::successful) << r.message;
-  ASSERT_EQ(last.size(), 3u * 4 * rows);
+  ASSERT_EQ(last.size(), static_cast<std::size_t>(3 * 4 * rows));
   double lowest = 1.0, top = 0.0;
   for (std::size_t k = 0; k < last.size(); k += 3) {
     lowest = std::min(lowest, last[k + 1]);

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 
 #include "simulation.hpp"
@@ -80,7 +81,7 @@ __attribute__((noinline)) bool Simulation<Dim, Shape>::return_to_wall(std::size_
   for (int a = 0; a < Dim; ++a) {
     const double xi = std::clamp((x[a] - grid_.origin[a]) * grid_.inv_h[a], 0.0,
                                  static_cast<double>(grid_.cells[a]));
-    node += static_cast<std::int64_t>(xi + 0.5) * grid_.stride[a];
+    node += std::lround(xi) * grid_.stride[a];
   }
   const auto i = static_cast<std::size_t>(node);
   for (int a = 0; a < Dim; ++a) {
