@@ -281,6 +281,12 @@ def collapse_spec(base, a, dim, across):
     h, rho, g = 0.01, 1800.0, 9.81
     spec = json.loads(json.dumps(base))
     mat = spec["materials"]["sand"]
+    # 2D: the example's plane-strain angle (35.26 deg, sin phi = tan 30 deg);
+    # 3D: 30 deg, as tests/solver/test_collapse.cpp (Davis's equivalence is
+    # a plane-strain result).
+    if dim == 3:
+        mat["friction_angle"] = 30.0
+    k0 = 1 - math.sin(math.radians(mat["friction_angle"]))
     if dim == 2:
         n_l = across if a >= 1 else round(across / a)
         n_h = round(n_l * a)
@@ -309,7 +315,7 @@ def collapse_spec(base, a, dim, across):
     spec["grid"] = {"min": [0.0] * dim, "max": [c * h for c in cells], "cells": cells}
     axis = "xyz"[up]
     sv = f"-{rho}*{g}*({h0}-{axis})"
-    stress = [f"-0.5*{rho}*{g}*({h0}-{axis})"] * 3 + [0, 0, 0]
+    stress = [f"-{k0}*{rho}*{g}*({h0}-{axis})"] * 3 + [0, 0, 0]
     stress[up] = sv
     spec["bodies"] = [{"material": "sand", "box": {"min": lo, "max": hi}, "particles_per_cell": 2,
                        "initial": {"effective_stress": stress}} for lo, hi in boxes]
@@ -349,26 +355,48 @@ def deposit_front(points, dim, h, h0):
     return r[r < end * h].max() + dp / 2
 
 
-def collapse_figure(hmpm, work, out):
+def deposit_toe(points, h, h0, l0):
+    """The toe of a 2D deposit as in tests/solver/test_collapse.cpp: the
+    thickness profile in bins max(h, min(H0, L0)/20) wide; from the wall the
+    contiguous bins at least 10 % of the largest thickness; a line fitted to
+    those at most 40 % of it, extrapolated to zero thickness."""
+    import numpy as np
+    dp = h / 2
+    bw = max(h, 0.05 * min(h0, l0))
+    x = points[:, 0]
+    t = np.bincount((x / bw).astype(int)) * dp * dp / bw
+    t_max = t.max()
+    fit, k = [], 0
+    while k < len(t) and t[k] >= 0.1 * t_max:
+        if t[k] <= 0.4 * t_max:
+            fit.append(k)
+        k += 1
+    slope, intercept = np.polyfit((np.array(fit) + 0.5) * bw, t[fit], 1)
+    return -intercept / slope
+
+
+def collapse_figure(hmpm, work, out, cells=(10, 20)):
+    """2D at a = 0.5, 1, 2, 5 with each number of cells across in `cells`
+    (the deposits drawn are those of the finest), and the 3D case."""
     import meshio
     base = json.loads((REPO / "examples" / "column-collapse.json").read_text())
-    cases = [(a, 2, 10) for a in (0.5, 1, 2, 5)] + [(1.0, 3, 8)]
+    cases = [(a, 2, n) for n in cells for a in (0.5, 1, 2, 5)] + [(1.0, 3, 8)]
     results = []
     for a, dim, across in cases:
         spec, h0, l0, h = collapse_spec(base, a, dim, across)
-        name = f"collapse-{dim}d-{a}"
+        name = f"collapse-{dim}d-{a}-{across}"
         path = pathlib.Path(work) / f"{name}.json"
         path.write_text(json.dumps(spec))
         subprocess.run([str(hmpm), "run", str(path), "--out", str(pathlib.Path(work) / name)],
                        check=True, capture_output=True)
         last = sorted((pathlib.Path(work) / name).glob("snapshot_*.vtu"))[-1]
         pts = meshio.read(last).points
-        front = deposit_front(pts, dim, h, h0)
+        front = deposit_toe(pts, h, h0, l0) if dim == 2 else deposit_front(pts, dim, h, h0)
         results.append((a, dim, across, (front - l0) / l0, pts / l0, front / l0))
     fig = plt.figure(figsize=(12, 5.5))
     grid = fig.add_gridspec(4, 2, width_ratios=[1.6, 1])
     ax2 = fig.add_subplot(grid[:, 1])
-    panels = [r for r in results if r[1] == 2]
+    panels = [r for r in results if r[1] == 2 and r[2] == max(cells)]
     for k, (a, dim, _, r, pts, front) in enumerate(panels):
         ax1 = fig.add_subplot(grid[k, 0])
         ax1.plot(pts[:, 0], pts[:, 1], ".", ms=1.0, color="tab:brown")
@@ -378,7 +406,8 @@ def collapse_figure(hmpm, work, out):
         ax1.set_ylabel(f"a = {a:g}\ny / L0", fontsize=8)
         ax1.tick_params(labelsize=7)
         if k == 0:
-            ax1.set_title("2D deposits at rest: front measured (dashed), Lube 2005 (blue)", fontsize=9)
+            ax1.set_title(f"2D deposits, {max(cells)} cells across: toe measured (dashed), "
+                          "Lube 2005 (blue)", fontsize=9)
         if k == len(panels) - 1:
             ax1.set_xlabel("x / L0")
     aa = [0.3 + 0.05 * i for i in range(100)]
@@ -387,11 +416,17 @@ def collapse_figure(hmpm, work, out):
     ax2.plot([x for x in aa if x >= 2.8], [1.9 * x ** (2 / 3) for x in aa if x >= 2.8], "k-", lw=1)
     ax2.plot([1.8, 2.8], [lube_2005(1.8), lube_2005(2.8)], "k:", lw=1, label="interpolated")
     ax2.plot([0.3, 1.7], [1.24 * 0.3, 1.24 * 1.7], "b--", lw=1, label="Lube 2004 (axisymmetric): 1.24 a")
+    markers = {n: m for n, m in zip(sorted(cells), ["o", "s", "^", "D"])}
+    for n in sorted(cells):
+        pts2 = [(a, r) for a, dim, across, r, *_ in results if dim == 2 and across == n]
+        ax2.plot([p[0] for p in pts2], [p[1] for p in pts2], markers[n], color="k",
+                 mfc="none" if n != max(cells) else "k", ms=5, ls="none", label=f"2D, {n} cells")
     for a, dim, _, r, *_ in results:
-        ax2.plot([a], [r], "ko" if dim == 2 else "bs", ms=5)
+        if dim == 3:
+            ax2.plot([a], [r], "bs", ms=5, label="3D, 8 cells across R0")
     ax2.set_xlabel("aspect ratio a = H0 / L0")
     ax2.set_ylabel("(L_inf - L0) / L0")
-    ax2.set_title("runout: hmpm (2D dots, 3D square) vs Lube")
+    ax2.set_title("runout: hmpm vs Lube")
     ax2.legend(fontsize=8)
     fig.tight_layout()
     fig.savefig(out / "column-collapse.png", dpi=110)
@@ -539,6 +574,9 @@ def main():
     ap.add_argument("--out", default=str(REPO / "docs" / "figures"))
     ap.add_argument("--only", choices=["bar", "darcy", "terzaghi", "mandel", "collapse", "slope"],
                     help="make one figure (and its table rows) only")
+    ap.add_argument("--collapse-cells", default="10,20",
+                    help="cells across min(H0, L0) of the 2D collapse runs, comma-separated "
+                         "(10,20,40 reproduces the convergence table; 40 takes about an hour)")
     args = ap.parse_args()
     out = pathlib.Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
@@ -555,7 +593,8 @@ def main():
         if want("mandel"):
             rows += mandel_figure(*run_example(args.hmpm, "mandel", work), out)
         if want("collapse"):
-            rows += collapse_figure(args.hmpm, work, out)
+            cells = tuple(int(n) for n in args.collapse_cells.split(","))
+            rows += collapse_figure(args.hmpm, work, out, cells)
         if want("slope"):
             rows += slope_figure(*run_example(args.hmpm, "slope-failure", work), out,
                                  pathlib.Path(work) / "slope-failure")
