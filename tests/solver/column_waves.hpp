@@ -94,7 +94,7 @@ inline std::vector<std::vector<double>> reference(const Column& c,
   return out;
 }
 
-using cplx = std::complex<double>;
+using Complex = std::complex<double>;
 
 /// The inverse Laplace transform of fhat at t > 0 by de Hoog, Knight and
 /// Stokes (1982): the Fourier series of e^{-gamma t} f(t) on [0, 2T],
@@ -105,46 +105,47 @@ double de_hoog(const F& fhat, double t, double T, int M, double negligible, doub
   const double pi = 3.14159265358979323846;
   const double gamma = -std::log(tol) / (2 * T);
   const int n = 2 * M;
-  std::vector<cplx> a(n + 1);
-  for (int k = 0; k <= n; ++k) a[k] = fhat(cplx(gamma, k * pi / T));
+  std::vector<Complex> a(n + 1);
+  for (int k = 0; k <= n; ++k) a[k] = fhat(Complex(gamma, k * pi / T));
   a[0] *= 0.5;
   // Terms that underflow to zero (a wave that has not arrived: the
   // transform is exp(-s z / c) small) would divide zero by zero below; the
   // series then bounds f by (2M + 1) max|a_k| e^{gamma t} / T.
-  if (std::find(a.begin(), a.end(), cplx(0.0)) != a.end()) {
+  if (std::find(a.begin(), a.end(), Complex(0.0)) != a.end()) {
     double bound = 0.0;
-    for (const cplx& v : a) bound = std::max(bound, std::abs(v));
+    for (const Complex& v : a) bound = std::max(bound, std::abs(v));
     bound *= (n + 1) * std::exp(gamma * t) / T;
     return bound < negligible ? 0.0 : std::numeric_limits<double>::quiet_NaN();
   }
   // Quotient-difference table: e[r][i], q[r][i].
-  std::vector<std::vector<cplx>> e(M + 1, std::vector<cplx>(n + 1)),
-      q(M + 1, std::vector<cplx>(n + 1));
+  std::vector<std::vector<Complex>> e(M + 1, std::vector<Complex>(n + 1)),
+      q(M + 1, std::vector<Complex>(n + 1));
   for (int i = 0; i < n; ++i) q[1][i] = a[i + 1] / a[i];
   for (int r = 1; r <= M; ++r) {
     for (int i = 0; i <= n - 2 * r; ++i) e[r][i] = q[r][i + 1] - q[r][i] + e[r - 1][i + 1];
     if (r < M)
       for (int i = 0; i <= n - 2 * r - 1; ++i) q[r + 1][i] = q[r][i + 1] * e[r][i + 1] / e[r][i];
   }
-  std::vector<cplx> d(n + 1);
+  std::vector<Complex> d(n + 1);
   d[0] = a[0];
   for (int r = 1; r <= M; ++r) {
-    d[2 * r - 1] = -q[r][0];
-    d[2 * r] = -e[r][0];
+    const int j = 2 * r;
+    d[j - 1] = -q[r][0];
+    d[j] = -e[r][0];
   }
-  const cplx z = std::exp(cplx(0, pi * t / T));
-  cplx A_prev = 0.0, A = d[0], B_prev = 1.0, B = 1.0;  // A_{-1}, A_0, B_{-1}, B_0
+  const Complex z = std::exp(Complex(0, pi * t / T));
+  Complex A_prev = 0.0, A = d[0], B_prev = 1.0, B = 1.0;  // A_{-1}, A_0, B_{-1}, B_0
   for (int k = 1; k < n; ++k) {
-    const cplx An = A + d[k] * z * A_prev, Bn = B + d[k] * z * B_prev;
+    const Complex An = A + d[k] * z * A_prev, Bn = B + d[k] * z * B_prev;
     A_prev = A;
     A = An;
     B_prev = B;
     B = Bn;
   }
   // Last term with the remainder estimate.
-  const cplx h = 0.5 * (1.0 + (d[n - 1] - d[n]) * z);
-  const cplx R = -h * (1.0 - std::sqrt(1.0 + d[n] * z / (h * h)));
-  const cplx An = A + R * A_prev, Bn = B + R * B_prev;
+  const Complex h = 0.5 * (1.0 + (d[n - 1] - d[n]) * z);
+  const Complex R = -h * (1.0 - std::sqrt(1.0 + d[n] * z / (h * h)));
+  const Complex An = A + R * A_prev, Bn = B + R * B_prev;
   return std::exp(gamma * t) / T * (An / Bn).real();
 }
 
@@ -156,35 +157,36 @@ double de_hoog(const F& fhat, double t, double T, int M, double negligible, doub
 /// the base (w = -kappa (p' + rho_f s^2 U) = 0 with U = 0), p = 0 and
 /// sigma' - p = -q at the top. Written with exp(r (x - H)) and exp(-r x)
 /// (Re r >= 0), so nothing overflows.
-inline std::array<cplx, 2> transformed(const Column& c, cplx s, cplx qhat, double x) {
+inline std::array<Complex, 2> transformed(const Column& c, Complex s, Complex qhat, double x) {
   const double E = c.e_oed, rho = c.rho(), Q = c.storage, kap = c.kappa, H = c.H;
-  const cplx a2 = E * kap;
-  const cplx a1 = -(E * Q * s + s + kap * s * s * (rho - c.rho_f));
-  const cplx a0 = rho * Q * s * s * s;
-  const cplx disc = std::sqrt(a1 * a1 - 4.0 * a2 * a0);
-  const cplx qq = -0.5 * (a1 + (std::real(std::conj(a1) * disc) >= 0 ? disc : -disc));
-  const cplx mu[2] = {qq / a2, a0 / qq};
-  cplx lam[4], beta[4];
+  const Complex a2 = E * kap;
+  const Complex a1 = -(E * Q * s + s + kap * s * s * (rho - c.rho_f));
+  const Complex a0 = rho * Q * s * s * s;
+  const Complex disc = std::sqrt(a1 * a1 - 4.0 * a2 * a0);
+  const Complex qq = -0.5 * (a1 + (std::real(std::conj(a1) * disc) >= 0 ? disc : -disc));
+  const Complex mu[2] = {qq / a2, a0 / qq};
+  Complex lam[4], beta[4];
   bool plus[4];
   for (int i = 0; i < 2; ++i) {
-    cplx r = std::sqrt(mu[i]);
+    Complex r = std::sqrt(mu[i]);
     if (r.real() < 0) r = -r;
-    lam[2 * i] = r;
-    lam[2 * i + 1] = -r;
-    plus[2 * i] = true;
-    plus[2 * i + 1] = false;
+    const int j = 2 * i;
+    lam[j] = r;
+    lam[j + 1] = -r;
+    plus[j] = true;
+    plus[j + 1] = false;
   }
   for (int k = 0; k < 4; ++k) beta[k] = (E * lam[k] * lam[k] - rho * s * s) / lam[k];
   auto phi = [&](int k, double xx) {
     return plus[k] ? std::exp(lam[k] * (xx - H)) : std::exp(lam[k] * xx);
   };
-  cplx m[4][5];
+  Complex m[4][5];
   for (int k = 0; k < 4; ++k) {
-    const cplx p0 = phi(k, 0.0), pH = phi(k, H);
-    m[0][k] = p0;
-    m[1][k] = beta[k] * lam[k] * p0;
-    m[2][k] = beta[k] * pH;
-    m[3][k] = E * lam[k] * pH;
+    const Complex at_base = phi(k, 0.0), at_top = phi(k, H);
+    m[0][k] = at_base;
+    m[1][k] = beta[k] * lam[k] * at_base;
+    m[2][k] = beta[k] * at_top;
+    m[3][k] = E * lam[k] * at_top;
   }
   m[0][4] = 0.0;
   m[1][4] = 0.0;
@@ -197,14 +199,14 @@ inline std::array<cplx, 2> transformed(const Column& c, cplx s, cplx qhat, doubl
     for (int k = 0; k < 5; ++k) std::swap(m[col][k], m[piv][k]);
     for (int r = 0; r < 4; ++r) {
       if (r == col) continue;
-      const cplx f = m[r][col] / m[col][col];
+      const Complex f = m[r][col] / m[col][col];
       for (int k = col; k < 5; ++k) m[r][k] -= f * m[col][k];
     }
   }
-  cplx sig = 0.0, p = 0.0;
+  Complex sig = 0.0, p = 0.0;
   for (int k = 0; k < 4; ++k) {
-    const cplx coef = m[k][4] / m[k][k];
-    const cplx ph = phi(k, x);
+    const Complex coef = m[k][4] / m[k][k];
+    const Complex ph = phi(k, x);
     sig += coef * E * lam[k] * ph;
     p += coef * beta[k] * ph;
   }
@@ -225,8 +227,8 @@ inline std::vector<std::vector<double>> exact(const Column& c, double q0, double
           row.push_back(0.0);
           continue;
         }
-        const auto fhat = [&](cplx s) {
-          const cplx qhat = q0 * (1.0 - std::exp(-s * ramp)) / (ramp * s * s);
+        const auto fhat = [&](Complex s) {
+          const Complex qhat = q0 * (1.0 - std::exp(-s * ramp)) / (ramp * s * s);
           return transformed(c, s, qhat, c.H - z)[f];
         };
         row.push_back(de_hoog(fhat, t, 2.0 * t, M, 1e-9 * q0));

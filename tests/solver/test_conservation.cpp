@@ -343,11 +343,11 @@ TEST(Walls, ParticlesOnAFloorStayInTheGrid) {
   opt.on_snapshot = [&](const hmpm::Snapshot& s) { last = s.position; };
   const hmpm::RunResult r = hmpm::run(p, opt);
   ASSERT_EQ(r.status, hmpm::RunStatus::successful) << r.message;
-  ASSERT_EQ(last.size(), static_cast<std::size_t>(3 * 4 * rows));
+  ASSERT_EQ(last.size(), static_cast<std::size_t>(rows) * 4 * 3);
   double lowest = 1.0, top = 0.0;
   for (std::size_t k = 0; k < last.size(); k += 3) {
     lowest = std::min(lowest, last[k + 1]);
-    if (k / 3 >= 4 * (rows - 1)) top += last[k + 1] / 4;
+    if (k / 3 >= static_cast<std::size_t>(rows - 1) * 4) top += last[k + 1] / 4;
   }
   EXPECT_GE(lowest, 0.0);
   // The top row at y_top = (rows - 1) sp; the material above a height y

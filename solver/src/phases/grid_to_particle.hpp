@@ -85,7 +85,8 @@ __attribute__((noinline)) bool Simulation<Dim, Shape>::return_to_wall(std::size_
   }
   const auto i = static_cast<std::size_t>(node);
   for (int a = 0; a < Dim; ++a) {
-    const bool below = x[a]<grid_.origin[a], above = x[a]> grid_max_[a];
+    const bool below = x[a] < grid_.origin[a];
+    const bool above = x[a] > grid_max_[a];
     if (!below && !above) continue;
     if (!(constraints_.prescribed_axes[i] & (1u << a))) return false;
     const double v = grid_.velocity[i][a];
