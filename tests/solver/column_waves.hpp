@@ -117,21 +117,20 @@ double de_hoog(const F& fhat, double t, double T, int M, double negligible, doub
     bound *= (n + 1) * std::exp(gamma * t) / T;
     return bound < negligible ? 0.0 : std::numeric_limits<double>::quiet_NaN();
   }
-  // Quotient-difference table: e[r][i], q[r][i].
-  std::vector<std::vector<Complex>> e(M + 1, std::vector<Complex>(n + 1)),
-      q(M + 1, std::vector<Complex>(n + 1));
-  for (int i = 0; i < n; ++i) q[1][i] = a[i + 1] / a[i];
-  for (int r = 1; r <= M; ++r) {
-    for (int i = 0; i <= n - 2 * r; ++i) e[r][i] = q[r][i + 1] - q[r][i] + e[r - 1][i + 1];
-    if (r < M)
-      for (int i = 0; i <= n - 2 * r - 1; ++i) q[r + 1][i] = q[r][i + 1] * e[r][i + 1] / e[r][i];
-  }
-  std::vector<Complex> d(n + 1);
+  // Quotient-difference table, one row r at a time (updated in place in
+  // increasing i, each entry reading only entries not yet overwritten):
+  // e_r[i] = q_r[i+1] - q_r[i] + e_{r-1}[i+1], q_{r+1}[i] = q_r[i+1] e_r[i+1] / e_r[i];
+  // the continued fraction's coefficients are d_{2r-1} = -q_r[0], d_{2r} = -e_r[0].
+  std::vector<Complex> e(n + 1), q(n + 1), d(n + 1);
+  for (int i = 0; i < n; ++i) q[i] = a[i + 1] / a[i];
   d[0] = a[0];
   for (int r = 1; r <= M; ++r) {
+    for (int i = 0; i <= n - 2 * r; ++i) e[i] = q[i + 1] - q[i] + e[i + 1];
     const int j = 2 * r;
-    d[j - 1] = -q[r][0];
-    d[j] = -e[r][0];
+    d[j - 1] = -q[0];
+    d[j] = -e[0];
+    if (r < M)
+      for (int i = 0; i <= n - 2 * r - 1; ++i) q[i] = q[i + 1] * e[i + 1] / e[i];
   }
   const Complex z = std::exp(Complex(0, pi * t / T));
   Complex A_prev = 0.0, A = d[0], B_prev = 1.0, B = 1.0;  // A_{-1}, A_0, B_{-1}, B_0
