@@ -1,16 +1,12 @@
 // schemes/quasi_static_reactions.cpp — the quasi-static scheme's boundary
-// reactions (QuasiStaticScheme::tally_reactions), for the dimension
-// HMPM_DIM and every shape function (solver/CMakeLists.txt compiles it
-// once per dimension, beside simulation_instance.cpp and linked after it).
+// reactions (QuasiStaticScheme::tally_reactions), for every dimension and
+// shape function (one unit: the headers are parsed once for the three
+// dimensions; solver/CMakeLists.txt links it after the Simulation units).
 // A unit of its own: in simulation_instance.cpp its call of
 // particle_stress changed GCC's inlining of particle_stress in the Newton
 // loop, and runs without reactions differed by round-off from before.
 #include "phases/particle_to_grid.hpp"
 #include "schemes/quasi_static_scheme.hpp"
-
-#ifndef HMPM_DIM
-#error "quasi_static_reactions.cpp needs HMPM_DIM (see solver/CMakeLists.txt)"
-#endif
 
 namespace hmpm {
 
@@ -59,8 +55,14 @@ void QuasiStaticScheme<Dim, Shape>::tally_reactions() {
   }
 }
 
-template void QuasiStaticScheme<HMPM_DIM, shape::Linear>::tally_reactions();
-template void QuasiStaticScheme<HMPM_DIM, shape::Gimp>::tally_reactions();
-template void QuasiStaticScheme<HMPM_DIM, shape::BSpline>::tally_reactions();
+template void QuasiStaticScheme<1, shape::Linear>::tally_reactions();
+template void QuasiStaticScheme<1, shape::Gimp>::tally_reactions();
+template void QuasiStaticScheme<1, shape::BSpline>::tally_reactions();
+template void QuasiStaticScheme<2, shape::Linear>::tally_reactions();
+template void QuasiStaticScheme<2, shape::Gimp>::tally_reactions();
+template void QuasiStaticScheme<2, shape::BSpline>::tally_reactions();
+template void QuasiStaticScheme<3, shape::Linear>::tally_reactions();
+template void QuasiStaticScheme<3, shape::Gimp>::tally_reactions();
+template void QuasiStaticScheme<3, shape::BSpline>::tally_reactions();
 
 }  // namespace hmpm
