@@ -258,10 +258,13 @@ double memory_bytes(const Problem& p, const CostEstimate& c, double threads) {
   // also keeps velocity and acceleration (and dp).
   const double sums = 8 * (1 + 3 * d) + (fluid ? 24 : 0);
   const double grid = sums + 16 * d + (fluid ? 8 : 0);
+  // The 3-node shape functions in 2D and 3D scatter mass, momentum and
+  // force through a 64-byte record per node and thread (NodeRecord).
+  const double records = p.shape_function != ShapeFunction::linear && d >= 2 ? 64 * threads : 0;
   const double nodes = static_cast<double>(c.nodes);
   const double particles = static_cast<double>(c.particles);
   double bytes = MemoryModel::base + particles * (particle + MemoryModel::setup_per_particle) +
-                 nodes * (grid + (threads - 1) * sums);
+                 nodes * (grid + (threads - 1) * sums + records);
   // The series: every value of every row, kept until the end of the run.
   const OutputRequest& o = p.output;
   double per_row = 1;  // time

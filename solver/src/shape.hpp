@@ -24,6 +24,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <type_traits>
 #ifdef __AVX__
 #include <immintrin.h>
 #endif
@@ -208,6 +209,110 @@ struct Stencil {
       compute_lanes<Grad, Located>(x, origin, inv_h, cells, stride, box, cell);
     else
       compute_scalar<Grad, Located>(x, origin, inv_h, cells, stride, box, cell);
+  }
+
+  /// Whether the phases sum this stencil row by row from its factors
+  /// (Axes) instead of node by node: the 3-node shape functions in 2D and 3D.
+  static constexpr bool factorised = K == 3 && Dim >= 2;
+
+  /// The stencil's factors without their tensor product (3-node shape
+  /// functions): the first node, and per axis the three weights and
+  /// derivatives per metre (lanes 0..2). A row is the three nodes along
+  /// axis 0 at one (j, k); node (i, j, k) has weight w[0][i] * wr and
+  /// gradient (dw[0][i] * wr, w[0][i] * dr[1], w[0][i] * dr[2]), with the
+  /// row's factors wr = w[1][j] w[2][k], dr[1] = dw[1][j] w[2][k],
+  /// dr[2] = w[1][j] dw[2][k] (for_rows). A pass sums a row along axis 0 with
+  /// the axis-0 factors and scales the sum by the row's: per node one
+  /// multiply-add per value, and no per-node weights to form or broadcast.
+  struct Axes {
+    std::int64_t node0;
+    Lanes w[Dim];
+    Lanes dw[Dim];
+
+    /// body(first node of the row, wr, dr) for the K^(Dim-1) rows; dr[0] is unused.
+    template <class Body>
+    __attribute__((always_inline)) inline void for_rows(const std::int64_t* stride,
+                                                        Body&& body) const {
+      std::array<double, Dim> dr{};
+      if constexpr (Dim == 2) {
+        for (int j = 0; j < K; ++j) {
+          dr[1] = dw[1][j];
+          body(node0 + j * stride[1], w[1][j], dr);
+        }
+      } else {
+        for (int k = 0; k < K; ++k)
+          for (int j = 0; j < K; ++j) {
+            dr[1] = dw[1][j] * w[2][k];
+            dr[2] = w[1][j] * dw[2][k];
+            body(node0 + j * stride[1] + k * stride[2], w[1][j] * w[2][k], dr);
+          }
+      }
+    }
+    /// sum_i c[i] v[i] over a row's three nodes (c: lanes 0..2 of an axis's
+    /// factors), component by component (plain arithmetic: no expression
+    /// template left out of line when a unit's inlining budget is spent).
+    template <class V>
+    __attribute__((always_inline)) static inline V row_sum(const Lanes& c, const V* v) {
+      if constexpr (std::is_same_v<V, double>) {
+        return c[0] * v[0] + c[1] * v[1] + c[2] * v[2];
+      } else if constexpr (V::SizeAtCompileTime == 2) {  // one SSE register per value
+        const Pair r = c[0] * pair(v[0]) + c[1] * pair(v[1]) + c[2] * pair(v[2]);
+        V out;
+        std::memcpy(out.data(), &r, sizeof r);
+        return out;
+      } else {
+        V r;
+        for (int a = 0; a < V::SizeAtCompileTime; ++a)
+          r[a] = c[0] * v[0][a] + c[1] * v[1][a] + c[2] * v[2][a];
+        return r;
+      }
+    }
+    /// to += s x, component by component.
+    template <class V>
+    __attribute__((always_inline)) static inline void add_scaled(V& to, double s, const V& x) {
+      if constexpr (V::SizeAtCompileTime == 2) {
+        const Pair r = pair(to) + s * pair(x);
+        std::memcpy(to.data(), &r, sizeof r);
+      } else {
+        for (int a = 0; a < V::SizeAtCompileTime; ++a) to[a] += s * x[a];
+      }
+    }
+
+   private:
+    using Pair = double __attribute__((vector_size(16)));
+    template <class V>
+    __attribute__((always_inline)) static inline Pair pair(const V& v) {
+      Pair p;
+      std::memcpy(&p, v.data(), sizeof p);
+      return p;
+    }
+
+   public:
+    /// The first and last node of the stencil.
+    std::int64_t first() const { return node0; }
+    std::int64_t last(const std::int64_t* stride) const {
+      std::int64_t n = node0 + K - 1;
+      for (int a = 1; a < Dim; ++a) n += (K - 1) * stride[a];
+      return n;
+    }
+  };
+
+  /// The factors of x's stencil; Located as in compute.
+  template <bool Located, class Vec>
+  __attribute__((always_inline)) static inline void axes(const Vec& x, const double* origin,
+                                                         const double* inv_h, const int* cells,
+                                                         const std::int64_t* stride, Box box,
+                                                         std::int32_t* cell, Axes& f) {
+    static_assert(K == 3);
+    int base[Dim];
+    for (int a = 0; a < Dim; ++a) {
+      const double xi = (x[a] - origin[a]) * inv_h[a];
+      if constexpr (!Located) cell[a] = Shape::locate(xi, cells[a]);
+      Shape::eval_lanes(xi, cell[a], cells[a], box, base[a], f.w[a], f.dw[a]);
+      f.dw[a] *= inv_h[a];
+    }
+    f.node0 = base[0];
+    for (int a = 1; a < Dim; ++a) f.node0 += base[a] * stride[a];
   }
 
  private:

@@ -102,6 +102,7 @@ class Simulation {
   // ------------------------------------------------------------ phases (phases/)
   void clear_grid();
   void map_particles_to_grid(const Out& out, std::size_t begin, std::size_t end);
+  void map_particles_to_grid_by_rows(const Out& out, std::size_t begin, std::size_t end);
   void compute_nodal_pressure(double t);
   void map_pore_pressure_force(const Out& out, std::size_t begin, std::size_t end);
   void apply_surface_loads(double t);
@@ -140,8 +141,9 @@ class Simulation {
 
   Out scatter_of(int t) {
     NodeRange* touched = &touched_[static_cast<std::size_t>(t)];
-    if (t == 0) return {grid_.pointers(), touched};
-    return {buffers_[static_cast<std::size_t>(t - 1)].pointers(), touched};
+    NodeRecord* records = records_[static_cast<std::size_t>(t)].data();
+    if (t == 0) return {grid_.pointers(), touched, records};
+    return {buffers_[static_cast<std::size_t>(t - 1)].pointers(), touched, records};
   }
 
   void setup_threads(int threads) {
@@ -149,6 +151,9 @@ class Simulation {
     buffers_.resize(static_cast<std::size_t>(threads - 1));
     touched_.assign(static_cast<std::size_t>(threads), NodeRange{0, grid_.count - 1});
     for (NodalSums<Dim>& b : buffers_) b.resize(static_cast<std::size_t>(grid_.count), fluid_);
+    records_.resize(static_cast<std::size_t>(threads));
+    if constexpr (StencilT::factorised)  // map_particles_to_grid_by_rows's scratch
+      for (auto& r : records_) r.assign(static_cast<std::size_t>(grid_.count), NodeRecord{});
   }
 
   /// Runs phase(scatter, begin, end) over particle chunks, then adds the
@@ -227,6 +232,14 @@ class Simulation {
   __attribute__((always_inline)) inline void stencil_in_step(std::size_t p, StencilT& s) {
     s.template compute<Grad, Located>(particles_.x[p], grid_.origin, grid_.inv_h, grid_.cells,
                                       grid_.stride, box_of(p), particles_.cell[p].data());
+  }
+
+  /// The factors of particle p's stencil (StencilT::factorised shape functions).
+  template <bool Located>
+  __attribute__((always_inline)) inline void axes_in_step(std::size_t p,
+                                                          typename StencilT::Axes& f) {
+    StencilT::template axes<Located>(particles_.x[p], grid_.origin, grid_.inv_h, grid_.cells,
+                                     grid_.stride, box_of(p), particles_.cell[p].data(), f);
   }
 
   /// Particle p's GIMP box (zero for the other shape functions).
@@ -311,8 +324,9 @@ class Simulation {
   StableStep stable_;
 
   std::unique_ptr<ThreadPool> pool_;
-  std::vector<NodalSums<Dim>> buffers_;  ///< threads 1.. : private nodal sums
-  std::vector<NodeRange> touched_;       ///< per thread, from the step's first phase
+  std::vector<NodalSums<Dim>> buffers_;           ///< threads 1.. : private nodal sums
+  std::vector<NodeRange> touched_;                ///< per thread, from the step's first phase
+  std::vector<std::vector<NodeRecord>> records_;  ///< per thread: particle-to-grid scratch
 
   std::mutex failure_mutex_;
   double damping_ = 0.0;  // local damping coefficient of the current step

@@ -86,6 +86,8 @@ RunResult Simulation<Dim, Shape>::run(const RunOptions& options) {
   result.particles = job_particles_;
   result.nodes = grid_.count;
   result.state_bytes = particles_.bytes() + dormant_.bytes() + grid_.bytes() * threads;
+  for (const auto& r : records_)
+    result.state_bytes += static_cast<std::int64_t>(r.size() * sizeof(NodeRecord));
   result.threads = threads;
   result.warnings = warnings_;
 

@@ -220,4 +220,57 @@ TEST(ShapeFunctions, StencilsAreTensorProductsOfTheAxes) {
   expect_tensor_product<3, BSpline>(Box{});
 }
 
+/// The factorised form the phases sum row by row (Stencil::Axes, for_rows)
+/// gives every node the index, weight and gradient of the tensor-product
+/// stencil: node (i, row) has weight w0_i wr and gradient (dw0_i wr,
+/// w0_i dr_1, w0_i dr_2). The products are grouped differently (w0_i (wy wz)
+/// against (w0_i wy) wz), so they agree to round-off, not bit for bit.
+/// Positions next to both grid edges are included (the B-spline's folded
+/// ghost nodes).
+template <int Dim, class Shape>
+void expect_rows_match_stencil(Box b) {
+  using StencilT = Stencil<Dim, Shape>;
+  static_assert(StencilT::factorised);
+  const int cells[3] = {7, 9, 6};
+  const double origin[3] = {-1.0, 0.5, 2.0}, h[3] = {0.5, 0.25, 2.0};
+  double inv_h[3];
+  for (int a = 0; a < 3; ++a) inv_h[a] = 1.0 / h[a];
+  const std::int64_t stride[3] = {1, cells[0] + 1, std::int64_t{cells[0] + 1} * (cells[1] + 1)};
+  const double where[5][3] = {
+      {0.3, 0.6, 0.1}, {2.77, 4.1, 3.3}, {6.9, 8.95, 5.999}, {3.5, 4.5, 2.5}, {0.01, 8.6, 5.4}};
+  for (const auto& xi : where) {
+    Eigen::Matrix<double, Dim, 1> x;
+    for (int a = 0; a < Dim; ++a) x[a] = origin[a] + xi[a] * h[a];
+    StencilT s;
+    std::int32_t cell[Dim];
+    s.template compute<true, false>(x, origin, inv_h, cells, stride, b, cell);
+    typename StencilT::Axes f;
+    StencilT::template axes<true>(x, origin, inv_h, cells, stride, b, cell, f);
+    EXPECT_EQ(f.first(), s.node[0]);
+    EXPECT_EQ(f.last(stride), s.node[StencilT::N - 1]);
+    int n = 0;
+    f.for_rows(stride, [&](std::int64_t row, double wr, const auto& dr) {
+      for (int i = 0; i < Shape::K; ++i, ++n) {
+        EXPECT_EQ(row + i, s.node[n]);
+        EXPECT_NEAR(f.w[0][i] * wr, s.w[n], round_off);
+        EXPECT_NEAR(f.dw[0][i] * wr, s.dw[0][n], round_off * inv_h[0]);
+        for (int a = 1; a < Dim; ++a)
+          EXPECT_NEAR(f.w[0][i] * dr[a], s.dw[a][n], round_off * inv_h[a]);
+      }
+    });
+    EXPECT_EQ(n, StencilT::N);
+    // The row sums the phases use: sum_i c_i v_i over a row's nodes.
+    const double v[3] = {1.5, -2.0, 0.25};
+    EXPECT_DOUBLE_EQ(StencilT::Axes::row_sum(f.w[0], v),
+                     f.w[0][0] * 1.5 - f.w[0][1] * 2.0 + f.w[0][2] * 0.25);
+  }
+}
+
+TEST(ShapeFunctions, RowFactorsReproduceTheTensorProductStencil) {
+  expect_rows_match_stencil<2, Gimp>(box(0.25));
+  expect_rows_match_stencil<3, Gimp>(box(1.0 / 6.0));
+  expect_rows_match_stencil<2, BSpline>(Box{});
+  expect_rows_match_stencil<3, BSpline>(Box{});
+}
+
 }  // namespace

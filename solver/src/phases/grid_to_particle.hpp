@@ -22,13 +22,29 @@ inline void Simulation<Dim, Shape>::update_particle_velocities_and_remap(const O
   // A local copy: the compiler otherwise reloads the pointer at every node
   // (Eigen's vector stores may alias it).
   Vec* const remap_out = at<nodal::remap>(out);
+  typename StencilT::Axes f;
   for (std::size_t p = begin; p < end; ++p) {
-    stencil_in_step<false, true>(p, s);
-    Vec a = Vec::Zero();
-    for (int k = 0; k < StencilT::N; ++k) a += s.w[k] * grid_.accel[s.node[k]];
-    particles_.v[p] += dt * a;
-    const Vec mv = particles_.mass[p] * particles_.v[p];
-    for (int k = 0; k < StencilT::N; ++k) remap_out[s.node[k]] += s.w[k] * mv;
+    if constexpr (StencilT::factorised) {  // row by row (StencilT::Axes)
+      axes_in_step<true>(p, f);
+      Vec a = Vec::Zero();
+      f.for_rows(grid_.stride, [&](std::int64_t row, double wr, const auto&) {
+        f.add_scaled(a, wr, f.row_sum(f.w[0], &grid_.accel[row]));
+      });
+      particles_.v[p] += dt * a;
+      const Vec mv = particles_.mass[p] * particles_.v[p];
+      f.for_rows(grid_.stride, [&](std::int64_t row, double wr, const auto&) {
+        Vec rmv;
+        for (int c = 0; c < Dim; ++c) rmv[c] = wr * mv[c];
+        for (int i = 0; i < 3; ++i) f.add_scaled(remap_out[row + i], f.w[0][i], rmv);
+      });
+    } else {
+      stencil_in_step<false, true>(p, s);
+      Vec a = Vec::Zero();
+      for (int k = 0; k < StencilT::N; ++k) a += s.w[k] * grid_.accel[s.node[k]];
+      particles_.v[p] += dt * a;
+      const Vec mv = particles_.mass[p] * particles_.v[p];
+      for (int k = 0; k < StencilT::N; ++k) remap_out[s.node[k]] += s.w[k] * mv;
+    }
   }
 }
 

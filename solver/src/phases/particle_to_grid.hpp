@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <cstring>
 
 #include "simulation.hpp"
 
@@ -37,6 +38,10 @@ inline typename Simulation<Dim, Shape>::Mat Simulation<Dim, Shape>::active_stres
 template <int Dim, class Shape>
 inline void Simulation<Dim, Shape>::map_particles_to_grid(const Out& out, std::size_t begin,
                                                           std::size_t end) {
+  if constexpr (StencilT::factorised) {
+    map_particles_to_grid_by_rows(out, begin, end);
+    return;
+  }
   StencilT s;
   NodeRange touched{grid_.count, -1};
   // Local copies: Eigen's vector stores may alias anything for the
@@ -80,6 +85,93 @@ inline void Simulation<Dim, Shape>::map_particles_to_grid(const Out& out, std::s
     }
   }
   *out.touched = touched;
+}
+
+/// Phase 1 for the factorised stencils (StencilT::Axes), row by row: the
+/// mass, momentum and force of a node go to the thread's NodeRecord (two
+/// aligned four-lane read-modify-writes per node), copied to the nodal sums
+/// after the loop.
+template <int Dim, class Shape>
+inline void Simulation<Dim, Shape>::map_particles_to_grid_by_rows(const Out& out, std::size_t begin,
+                                                                  std::size_t end) {
+  if constexpr (StencilT::factorised) {  // (explicit instantiation compiles it for every shape)
+    typename StencilT::Axes f;
+    NodeRange touched{grid_.count, -1};
+    using shape::Lanes;
+    NodeRecord* const records = out.records;
+    double* const storage_out = at<nodal::storage>(out);
+    double* const pressure_out = at<nodal::pressure>(out);
+    for (std::size_t p = begin; p < end; ++p) {
+      const double m = particles_.mass[p];
+      const double vol = particles_.volume[p];
+      const Vec mv = m * particles_.v[p];
+      const Mat vol_sig = vol * active_stress(particles_.stress[p]);
+      // A node's record gains w [m, m v] and -vol sigma grad N (NodeRecord).
+      Lanes mass_momentum = {m, 0.0, 0.0, 0.0};
+      for (int a = 0; a < Dim; ++a) mass_momentum[1 + a] = mv[a];
+      Lanes column[Dim];
+      for (int b = 0; b < Dim; ++b) {
+        column[b] = Lanes{0.0, 0.0, 0.0, 0.0};
+        for (int a = 0; a < Dim; ++a) column[b][a] = vol_sig(a, b);
+      }
+      auto add = [&](NodeRecord& r, Lanes mm, Lanes force) {
+        Lanes lanes_a, lanes_b;
+        std::memcpy(&lanes_a, r.a, sizeof lanes_a);
+        std::memcpy(&lanes_b, r.b, sizeof lanes_b);
+        lanes_a += mm;
+        lanes_b -= force;
+        std::memcpy(r.a, &lanes_a, sizeof lanes_a);
+        std::memcpy(r.b, &lanes_b, sizeof lanes_b);
+      };
+      const std::uint16_t mat = particles_.material[p];
+      const bool fluid = fluid_ && constants_[mat].saturated;
+      double qv = 0.0, qvp = 0.0;  // storage Q V and Q V p
+      if (fluid) {
+        const double n = particles_.porosity[p];
+        qv = ((1.0 - n) * inv_ks_[mat] + n * inv_kf_[mat]) * vol;
+        qvp = qv * particles_.pressure[p];
+      }
+      axes_in_step<false>(p, f);
+      touched.lo = std::min(touched.lo, f.first());
+      touched.hi = std::max(touched.hi, f.last(grid_.stride));
+      const Lanes wx0 = Lanes{} + f.w[0][0], wx1 = Lanes{} + f.w[0][1], wx2 = Lanes{} + f.w[0][2];
+      const Lanes dx0 = Lanes{} + f.dw[0][0], dx1 = Lanes{} + f.dw[0][1],
+                  dx2 = Lanes{} + f.dw[0][2];
+      f.for_rows(grid_.stride, [&](std::int64_t row, double wr, const auto& dr) {
+        const Lanes mm = wr * mass_momentum;
+        const Lanes along = wr * column[0];
+        Lanes across = dr[1] * column[1];
+        for (int c = 2; c < Dim; ++c) across += dr[c] * column[c];
+        NodeRecord* const r = records + row;
+        add(r[0], wx0 * mm, dx0 * along + wx0 * across);
+        add(r[1], wx1 * mm, dx1 * along + wx1 * across);
+        add(r[2], wx2 * mm, dx2 * along + wx2 * across);
+      });
+      if (fluid) {
+        const double wx[3] = {f.w[0][0], f.w[0][1], f.w[0][2]};
+        f.for_rows(grid_.stride, [&](std::int64_t row, double wr, const auto&) {
+          const double sq = wr * qv, sp = wr * qvp;
+          for (int i = 0; i < 3; ++i) {
+            storage_out[row + i] += wx[i] * sq;
+            pressure_out[row + i] += wx[i] * sp;
+          }
+        });
+      }
+    }
+    *out.touched = touched;
+    double* const mass_out = at<nodal::mass>(out);
+    Vec* const momentum_out = at<nodal::momentum>(out);
+    Vec* const force_out = at<nodal::force>(out);
+    for (std::int64_t i = touched.lo; i <= touched.hi; ++i) {
+      NodeRecord& r = records[i];
+      mass_out[i] += r.a[0];
+      for (int a = 0; a < Dim; ++a) {
+        momentum_out[i][a] += r.a[1 + a];
+        force_out[i][a] += r.b[a];
+      }
+      r = NodeRecord{};
+    }
+  }
 }
 
 /// Surface loads at time t (boundary/tractions.hpp) added to the nodal force.

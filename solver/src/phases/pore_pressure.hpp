@@ -30,13 +30,33 @@ template <int Dim, class Shape>
 inline void Simulation<Dim, Shape>::map_pore_pressure_force(const Out& out, std::size_t begin,
                                                             std::size_t end) {
   StencilT s;
+  typename StencilT::Axes f;
+  Vec* const force_out = at<nodal::force>(out);
   for (std::size_t p = begin; p < end; ++p) {
     if (!constants_[particles_.material[p]].saturated) continue;
-    stencil_in_step<true, true>(p, s);
-    double p_hat = 0.0;
-    for (int k = 0; k < StencilT::N; ++k) p_hat += s.w[k] * grid_.pressure[s.node[k]];
-    const double vp = particles_.volume[p] * p_hat;
-    for (int k = 0; k < StencilT::N; ++k) at<nodal::force>(out)[s.node[k]] += vp * s.grad(k);
+    if constexpr (StencilT::factorised) {  // row by row (StencilT::Axes)
+      axes_in_step<true>(p, f);
+      double p_hat = 0.0;
+      f.for_rows(grid_.stride, [&](std::int64_t row, double wr, const auto&) {
+        p_hat += wr * f.row_sum(f.w[0], &grid_.pressure[row]);
+      });
+      const double vp = particles_.volume[p] * p_hat;
+      f.for_rows(grid_.stride, [&](std::int64_t row, double wr, const auto& dr) {
+        // vp grad N of node i: (dw_i vp wr, w_i vp dr_1, ..)
+        const double along = vp * wr;
+        for (int i = 0; i < 3; ++i) {
+          Vec& to = force_out[row + i];
+          to[0] += f.dw[0][i] * along;
+          for (int a = 1; a < Dim; ++a) to[a] += f.w[0][i] * (vp * dr[a]);
+        }
+      });
+    } else {
+      stencil_in_step<true, true>(p, s);
+      double p_hat = 0.0;
+      for (int k = 0; k < StencilT::N; ++k) p_hat += s.w[k] * grid_.pressure[s.node[k]];
+      const double vp = particles_.volume[p] * p_hat;
+      for (int k = 0; k < StencilT::N; ++k) force_out[s.node[k]] += vp * s.grad(k);
+    }
   }
 }
 
@@ -59,7 +79,31 @@ inline void Simulation<Dim, Shape>::update_particle_pressure_and_position(std::s
                                                                           std::size_t end,
                                                                           double dt) {
   StencilT s;
+  typename StencilT::Axes f;
   for (std::size_t p = begin; p < end; ++p) {
+    if constexpr (StencilT::factorised) {  // row by row (StencilT::Axes)
+      axes_in_step<true>(p, f);
+      const bool saturated = constants_[particles_.material[p]].saturated;
+      double dp = 0.0, p_new = 0.0;
+      Vec v = Vec::Zero();
+      f.for_rows(grid_.stride, [&](std::int64_t row, double wr, const auto&) {
+        if (saturated) {
+          const double* const d = &grid_.dp[row];
+          const double* const pr = &grid_.pressure[row];
+          const double pn[3] = {pr[0] + d[0], pr[1] + d[1], pr[2] + d[2]};
+          dp += wr * f.row_sum(f.w[0], d);
+          p_new += wr * f.row_sum(f.w[0], pn);
+        }
+        f.add_scaled(v, wr, f.row_sum(f.w[0], &grid_.velocity[row]));
+      });
+      if (saturated) {
+        particles_.pressure[p] += dp;
+        particles_.pressure_out[p] = p_new;
+        if (!std::isfinite(p_new)) fail_nonfinite(p, "pore pressure");
+      }
+      displace_particle(p, v, dt);
+      continue;
+    }
     stencil_in_step<false, true>(p, s);
     if (constants_[particles_.material[p]].saturated) {
       double dp = 0.0, p_new = 0.0;  // weights only: this pass needs no gradient

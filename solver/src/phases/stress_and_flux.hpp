@@ -27,18 +27,36 @@ inline void Simulation<Dim, Shape>::update_particle_stress_and_fluid_flux(const 
                                                                           std::size_t end,
                                                                           double dt) {
   StencilT s;
+  typename StencilT::Axes f;
   // A local copy (Eigen's stores may alias the pointer for the compiler).
   double* const flux_out = Fluid && ScatterFlux ? at<nodal::flux>(out) : nullptr;
   for (std::size_t p = begin; p < end; ++p) {
-    stencil_in_step<true, true>(p, s);
     Mat grad_v = Mat::Zero();
     // Dry runs move the particle in this phase: its velocity is gathered
     // from the same nodes in the same loop (the same sums, in the same order,
     // as move_particle's).
     Vec v_move = Vec::Zero();
-    for (int k = 0; k < StencilT::N; ++k) {
-      grad_v.noalias() += grid_.remap[s.node[k]] * s.grad(k).transpose();
-      if constexpr (!Fluid) v_move += s.w[k] * grid_.velocity[s.node[k]];
+    if constexpr (StencilT::factorised) {
+      // Row by row (StencilT::Axes): sums along axis 0 with the axis-0
+      // factors, scaled by the row's factors.
+      axes_in_step<true>(p, f);
+      Vec column[Dim];  // of grad_v
+      for (int c = 0; c < Dim; ++c) column[c] = Vec::Zero();
+      f.for_rows(grid_.stride, [&](std::int64_t row, double wr, const auto& dr) {
+        const Vec* const r = &grid_.remap[row];
+        f.add_scaled(column[0], wr, f.row_sum(f.dw[0], r));
+        const Vec sw = f.row_sum(f.w[0], r);
+        for (int c = 1; c < Dim; ++c) f.add_scaled(column[c], dr[c], sw);
+        if constexpr (!Fluid) f.add_scaled(v_move, wr, f.row_sum(f.w[0], &grid_.velocity[row]));
+      });
+      for (int c = 0; c < Dim; ++c)
+        for (int a = 0; a < Dim; ++a) grad_v(a, c) = column[c][a];
+    } else {
+      stencil_in_step<true, true>(p, s);
+      for (int k = 0; k < StencilT::N; ++k) {
+        grad_v.noalias() += grid_.remap[s.node[k]] * s.grad(k).transpose();
+        if constexpr (!Fluid) v_move += s.w[k] * grid_.velocity[s.node[k]];
+      }
     }
     const double vol = particles_.volume[p];
     const std::uint16_t mat = particles_.material[p];
@@ -46,19 +64,54 @@ inline void Simulation<Dim, Shape>::update_particle_stress_and_fluid_flux(const 
     if (Fluid && mc.saturated) {
       const double div_v = grad_v.trace();
       Vec grad_p = Vec::Zero(), a = Vec::Zero();
-      for (int k = 0; k < StencilT::N; ++k) {
+      // The pressure of the Darcy flux: p^n, or (semi-implicit, whose
+      // increment is known) p^{n+1}.
+      auto pressure_at = [&](std::int64_t i) {
         if constexpr (ScatterFlux)
-          grad_p += grid_.pressure[s.node[k]] * s.grad(k);
-        else  // semi-implicit: the increment is known, the Darcy flux is of p^{n+1}
-          grad_p += (grid_.pressure[s.node[k]] + grid_.dp[s.node[k]]) * s.grad(k);
-        a += s.w[k] * grid_.accel[s.node[k]];
+          return grid_.pressure[i];
+        else
+          return grid_.pressure[i] + grid_.dp[i];
+      };
+      if constexpr (StencilT::factorised) {
+        f.for_rows(grid_.stride, [&](std::int64_t row, double wr, const auto& dr) {
+          const double pr[3] = {pressure_at(row), pressure_at(row + 1), pressure_at(row + 2)};
+          grad_p[0] += wr * f.row_sum(f.dw[0], pr);
+          const double pw = f.row_sum(f.w[0], pr);
+          for (int c = 1; c < Dim; ++c) grad_p[c] += dr[c] * pw;
+          f.add_scaled(a, wr, f.row_sum(f.w[0], &grid_.accel[row]));
+        });
+      } else {
+        for (int k = 0; k < StencilT::N; ++k) {
+          grad_p += pressure_at(s.node[k]) * s.grad(k);
+          a += s.w[k] * grid_.accel[s.node[k]];
+        }
       }
-      const Vec w = -mc.permeability_over_gamma *
-                    (grad_p - mc.fluid_density * gravity_ + mc.darcy_inertia_density * a);
+      // Component by component (an expression template here was left out of line).
+      Vec w;
+      for (int c = 0; c < Dim; ++c)
+        w[c] = -mc.permeability_over_gamma *
+               (grad_p[c] - mc.fluid_density * gravity_[c] + mc.darcy_inertia_density * a[c]);
       particles_.darcy[p] = w;
-      if constexpr (ScatterFlux)
-        for (int k = 0; k < StencilT::N; ++k)
-          flux_out[s.node[k]] += vol * (s.grad(k).dot(w) - s.w[k] * div_v);
+      if constexpr (ScatterFlux) {
+        if constexpr (StencilT::factorised) {
+          // vol (grad N . w - N div v) = dw_i (vol wr w_0) + w_i vol (sum dr_c w_c - wr div v)
+          const double wx0 = f.w[0][0], wx1 = f.w[0][1], wx2 = f.w[0][2];
+          const double dx0 = f.dw[0][0], dx1 = f.dw[0][1], dx2 = f.dw[0][2];
+          f.for_rows(grid_.stride, [&](std::int64_t row, double wr, const auto& dr) {
+            const double c0 = vol * wr * w[0];
+            double along = -wr * div_v;
+            for (int c = 1; c < Dim; ++c) along += dr[c] * w[c];
+            const double c1 = vol * along;
+            double* const to = flux_out + row;
+            to[0] += dx0 * c0 + wx0 * c1;
+            to[1] += dx1 * c0 + wx1 * c1;
+            to[2] += dx2 * c0 + wx2 * c1;
+          });
+        } else {
+          for (int k = 0; k < StencilT::N; ++k)
+            flux_out[s.node[k]] += vol * (s.grad(k).dot(w) - s.w[k] * div_v);
+        }
+      }
     }
     Voigt de = Voigt::Zero();
     for (int a = 0; a < Dim; ++a) de[a] = grad_v(a, a) * dt;

@@ -117,12 +117,24 @@ struct NodeRange {
   std::int64_t lo, hi;
 };
 
+/// One node's mass, momentum and force as two four-lane vectors, the
+/// particle-to-grid phase's scratch: [m, m v (Dim lanes), 0...] and
+/// [f (Dim lanes), 0...]. Every particle adds to a node with the same two
+/// aligned 32-byte read-modify-writes (one pair of addresses per node), so
+/// the next particle's loads are forwarded from the stores before them; the
+/// phase then copies the records to the nodal sums.
+struct alignas(64) NodeRecord {
+  double a[4];
+  double b[4];
+};
+
 /// Where one thread's particle phase scatters: the grid's own sums (thread
 /// 0) or the thread's private buffer.
 template <int Dim>
 struct Scatter {
   typename NodalSums<Dim>::Pointers to;
-  NodeRange* touched;  ///< set by the step's first phase (particles do not move before the last)
+  NodeRange* touched;   ///< set by the step's first phase (particles do not move before the last)
+  NodeRecord* records;  ///< the thread's scratch records (zero outside the phase)
 };
 
 /// The array of nodal sum F a phase scatters into.
