@@ -242,6 +242,22 @@ class Simulation {
                                      grid_.stride, box_of(p), particles_.cell[p].data(), f);
   }
 
+  /// In a loop over particles [begin, end), particle p's factors (computed
+  /// at the previous particle) after computing particle p + 1's: the chain
+  /// of dependent operations of a stencil's factors then overlaps the
+  /// current particle's sums (software pipelining; 4-9 % of a 2D step).
+  /// `ahead` holds the two. Nothing computed for the node-by-node shape
+  /// functions (!StencilT::factorised).
+  template <bool Located>
+  __attribute__((always_inline)) inline const typename StencilT::Axes& axes_ahead(
+      std::size_t p, std::size_t begin, std::size_t end, typename StencilT::Axes* ahead) {
+    if constexpr (StencilT::factorised) {
+      if (p == begin) axes_in_step<Located>(p, ahead[0]);
+      if (p + 1 < end) axes_in_step<Located>(p + 1, ahead[(p + 1 - begin) & 1]);
+    }
+    return ahead[(p - begin) & 1];
+  }
+
   /// Particle p's GIMP box (zero for the other shape functions).
   inline shape::Box box_of(std::size_t p) const { return shape::box_of(particles_, p); }
 

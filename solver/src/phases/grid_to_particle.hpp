@@ -22,10 +22,10 @@ inline void Simulation<Dim, Shape>::update_particle_velocities_and_remap(const O
   // A local copy: the compiler otherwise reloads the pointer at every node
   // (Eigen's vector stores may alias it).
   Vec* const remap_out = at<nodal::remap>(out);
-  typename StencilT::Axes f;
+  typename StencilT::Axes ahead[2];
   for (std::size_t p = begin; p < end; ++p) {
+    const auto& f = axes_ahead<true>(p, begin, end, ahead);
     if constexpr (StencilT::factorised) {  // row by row (StencilT::Axes)
-      axes_in_step<true>(p, f);
       Vec a = Vec::Zero();
       f.for_rows(grid_.stride, [&](std::int64_t row, double wr, const auto&) {
         f.add_scaled(a, wr, f.row_sum(f.w[0], &grid_.accel[row]));

@@ -95,13 +95,14 @@ template <int Dim, class Shape>
 inline void Simulation<Dim, Shape>::map_particles_to_grid_by_rows(const Out& out, std::size_t begin,
                                                                   std::size_t end) {
   if constexpr (StencilT::factorised) {  // (explicit instantiation compiles it for every shape)
-    typename StencilT::Axes f;
     NodeRange touched{grid_.count, -1};
     using shape::Lanes;
     NodeRecord* const records = out.records;
+    typename StencilT::Axes ahead[2];
     double* const storage_out = at<nodal::storage>(out);
     double* const pressure_out = at<nodal::pressure>(out);
     for (std::size_t p = begin; p < end; ++p) {
+      const auto& f = axes_ahead<false>(p, begin, end, ahead);
       const double m = particles_.mass[p];
       const double vol = particles_.volume[p];
       const Vec mv = m * particles_.v[p];
@@ -131,7 +132,6 @@ inline void Simulation<Dim, Shape>::map_particles_to_grid_by_rows(const Out& out
         qv = ((1.0 - n) * inv_ks_[mat] + n * inv_kf_[mat]) * vol;
         qvp = qv * particles_.pressure[p];
       }
-      axes_in_step<false>(p, f);
       touched.lo = std::min(touched.lo, f.first());
       touched.hi = std::max(touched.hi, f.last(grid_.stride));
       const Lanes wx0 = Lanes{} + f.w[0][0], wx1 = Lanes{} + f.w[0][1], wx2 = Lanes{} + f.w[0][2];

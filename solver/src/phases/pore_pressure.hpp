@@ -30,12 +30,12 @@ template <int Dim, class Shape>
 inline void Simulation<Dim, Shape>::map_pore_pressure_force(const Out& out, std::size_t begin,
                                                             std::size_t end) {
   StencilT s;
-  typename StencilT::Axes f;
+  typename StencilT::Axes ahead[2];
   Vec* const force_out = at<nodal::force>(out);
   for (std::size_t p = begin; p < end; ++p) {
+    const auto& f = axes_ahead<true>(p, begin, end, ahead);
     if (!constants_[particles_.material[p]].saturated) continue;
     if constexpr (StencilT::factorised) {  // row by row (StencilT::Axes)
-      axes_in_step<true>(p, f);
       double p_hat = 0.0;
       f.for_rows(grid_.stride, [&](std::int64_t row, double wr, const auto&) {
         p_hat += wr * f.row_sum(f.w[0], &grid_.pressure[row]);
@@ -79,10 +79,10 @@ inline void Simulation<Dim, Shape>::update_particle_pressure_and_position(std::s
                                                                           std::size_t end,
                                                                           double dt) {
   StencilT s;
-  typename StencilT::Axes f;
+  typename StencilT::Axes ahead[2];
   for (std::size_t p = begin; p < end; ++p) {
+    const auto& f = axes_ahead<true>(p, begin, end, ahead);
     if constexpr (StencilT::factorised) {  // row by row (StencilT::Axes)
-      axes_in_step<true>(p, f);
       const bool saturated = constants_[particles_.material[p]].saturated;
       double dp = 0.0, p_new = 0.0;
       Vec v = Vec::Zero();

@@ -27,10 +27,11 @@ inline void Simulation<Dim, Shape>::update_particle_stress_and_fluid_flux(const 
                                                                           std::size_t end,
                                                                           double dt) {
   StencilT s;
-  typename StencilT::Axes f;
+  typename StencilT::Axes ahead[2];
   // A local copy (Eigen's stores may alias the pointer for the compiler).
   double* const flux_out = Fluid && ScatterFlux ? at<nodal::flux>(out) : nullptr;
   for (std::size_t p = begin; p < end; ++p) {
+    const auto& f = axes_ahead<true>(p, begin, end, ahead);
     Mat grad_v = Mat::Zero();
     // Dry runs move the particle in this phase: its velocity is gathered
     // from the same nodes in the same loop (the same sums, in the same order,
@@ -39,7 +40,6 @@ inline void Simulation<Dim, Shape>::update_particle_stress_and_fluid_flux(const 
     if constexpr (StencilT::factorised) {
       // Row by row (StencilT::Axes): sums along axis 0 with the axis-0
       // factors, scaled by the row's factors.
-      axes_in_step<true>(p, f);
       Vec column[Dim];  // of grad_v
       for (int c = 0; c < Dim; ++c) column[c] = Vec::Zero();
       f.for_rows(grid_.stride, [&](std::int64_t row, double wr, const auto& dr) {
@@ -139,10 +139,10 @@ inline void Simulation<Dim, Shape>::update_particle_stress_and_fluid_flux(const 
     // element by element: Eigen's assignment loop may be left out of line in
     // a translation unit whose inlining budget is spent, which changes the
     // rounding (FMA contraction) of the determinant.
-    Mat f;
+    Mat def;
     for (int a = 0; a < Dim; ++a)
-      for (int b = 0; b < Dim; ++b) f(a, b) = (a == b ? 1.0 : 0.0) + dt * grad_v(a, b);
-    const double j = f.determinant();
+      for (int b = 0; b < Dim; ++b) def(a, b) = (a == b ? 1.0 : 0.0) + dt * grad_v(a, b);
+    const double j = def.determinant();
     if (!(j > 0.0)) fail_volume(p, j);
     particles_.volume[p] = vol * j;
     if (Fluid && mc.saturated) particles_.porosity[p] = 1.0 - (1.0 - particles_.porosity[p]) / j;
