@@ -23,15 +23,25 @@ inline void Simulation<Dim, Shape>::update_particle_velocities_and_remap(const O
   // (Eigen's vector stores may alias it).
   Vec* const remap_out = at<nodal::remap>(out);
   typename StencilT::Axes ahead[2];
+  // The same for the arrays read and written per particle (the stores to
+  // remap_out may alias them for the compiler, which then reloads the
+  // particle's velocity it has just stored).
+  const Vec* const accel = grid_.accel.data();
+  const double* const mass = particles_.mass.data();
+  Vec* const velocity = particles_.v.data();
   for (std::size_t p = begin; p < end; ++p) {
     const auto& f = axes_ahead<true>(p, begin, end, ahead);
     if constexpr (StencilT::factorised) {  // row by row (StencilT::Axes)
       Vec a = Vec::Zero();
       f.for_rows(grid_.stride, [&](std::int64_t row, double wr, const auto&) {
-        f.add_scaled(a, wr, f.row_sum(f.w[0], &grid_.accel[row]));
+        f.add_scaled(a, wr, f.row_sum(f.w[0], accel + row));
       });
-      particles_.v[p] += dt * a;
-      const Vec mv = particles_.mass[p] * particles_.v[p];
+      const double m = mass[p];
+      Vec v = velocity[p];
+      f.add_scaled(v, dt, a);
+      velocity[p] = v;
+      Vec mv;
+      for (int c = 0; c < Dim; ++c) mv[c] = m * v[c];
       f.for_rows(grid_.stride, [&](std::int64_t row, double wr, const auto&) {
         Vec rmv;
         for (int c = 0; c < Dim; ++c) rmv[c] = wr * mv[c];
