@@ -77,20 +77,34 @@ row() {
       line=$out
     fi
   done
-  local particles threads state rss dim nb steps ref
+  local particles threads state rss dim nb steps ref coupled shape key of_linear
   dim=$(value dim <<<" $line")
   nb=$(value nb <<<"$line")
   steps=$(value steps <<<"$line")
+  coupled=$(value coupled <<<"$line")
+  shape=$(value shape <<<"$line")
   reference_for "$dim" "$nb" "$steps"
   ref=$reference_value
   particles=$(value particles <<<"$line")
   threads=$(value threads <<<"$line")
   state=$(value state_bytes_per_particle <<<"$line")
   rss=$(value peak_rss_bytes_per_particle <<<"$line")
-  printf '| %s | %s | %s | %.2f M | %.2f× | %.0f | %.0f |\n' "$label" "$particles" "$threads" \
+  # The shape functions against linear of the same dimension, size and kind
+  # (issue 21's targets), measured earlier in the same script.
+  key="$dim/$nb/$coupled/$threads"
+  if [[ $shape == linear ]]; then
+    linear_ps[$key]=$best
+    of_linear=1
+  elif [[ -n ${linear_ps[$key]:-} ]]; then
+    of_linear=$(awk -v a="$best" -v b="${linear_ps[$key]}" 'BEGIN{printf "%.2f", a / b}')
+  else
+    of_linear="—"
+  fi
+  printf '| %s | %s | %s | %.2f M | %.2f× | %s× | %.0f | %.0f |\n' "$label" "$particles" "$threads" \
     "$(awk -v v="$best" 'BEGIN{print v / 1e6}')" "$(awk -v a="$best" -v b="$ref" 'BEGIN{print a / b}')" \
-    "$state" "$rss"
+    "$of_linear" "$state" "$rss"
 }
+declare -A linear_ps
 
 steps_for() {  # particles-per-cell^dim * nb^dim -> steps for ~$work particle-steps
   local n=$1
@@ -100,8 +114,8 @@ steps_for() {  # particles-per-cell^dim * nb^dim -> steps for ~$work particle-st
 }
 
 table() {
-  echo '| case | particles | threads | particle-steps/s | ÷ reference kernel | state B/particle | peak RSS B/particle |'
-  echo '|---|---:|---:|---:|---:|---:|---:|'
+  echo '| case | particles | threads | particle-steps/s | ÷ reference kernel | ÷ linear | state B/particle | peak RSS B/particle |'
+  echo '|---|---:|---:|---:|---:|---:|---:|---:|'
   local nb n
   for coupled in "" "--coupled"; do
     local kind=dry
@@ -117,16 +131,20 @@ table() {
       row "3D $kind linear" --dim 3 --nb "$nb" --steps "$(steps_for $n)" --threads 1 $coupled
     done
   done
-  # Shape functions at about 100k particles.
-  local nbs=${nb2d[1]:-${nb2d[0]}} nbs3=${nb3d[1]:-${nb3d[0]}}
-  for shape in gimp bspline; do
-    for coupled in "" "--coupled"; do
-      local kind=dry
-      [[ -n $coupled ]] && kind=coupled
-      # shellcheck disable=SC2086
-      row "2D $kind $shape" --dim 2 --nb "$nbs" --steps "$(steps_for $((4 * nbs * nbs)))" --threads 1 --shape $shape $coupled
-      # shellcheck disable=SC2086
-      row "3D $kind $shape" --dim 3 --nb "$nbs3" --steps "$(steps_for $((8 * nbs3 * nbs3 * nbs3)))" --threads 1 --shape $shape $coupled
+  # Shape functions at about 100k and 400k particles (the quick run: its one size).
+  local size
+  for size in 1 2; do
+    local nbs=${nb2d[$size]:-} nbs3=${nb3d[$size]:-}
+    [[ -z $nbs ]] && { ((size == 1)) || continue; nbs=${nb2d[0]}; nbs3=${nb3d[0]}; }
+    for shape in gimp bspline; do
+      for coupled in "" "--coupled"; do
+        local kind=dry
+        [[ -n $coupled ]] && kind=coupled
+        # shellcheck disable=SC2086
+        row "2D $kind $shape" --dim 2 --nb "$nbs" --steps "$(steps_for $((4 * nbs * nbs)))" --threads 1 --shape $shape $coupled
+        # shellcheck disable=SC2086
+        row "3D $kind $shape" --dim 3 --nb "$nbs3" --steps "$(steps_for $((8 * nbs3 * nbs3 * nbs3)))" --threads 1 --shape $shape $coupled
+      done
     done
   done
 }

@@ -54,6 +54,14 @@ inline Lanes lanes_min(Lanes a, Lanes b) {
   return b < a ? b : a;
 }
 #endif
+/// |a| lane by lane (the sign bit cleared: one vandpd, not a negation and a maximum).
+inline Lanes lanes_abs(Lanes a) {
+#ifdef __AVX__
+  return _mm256_andnot_pd(_mm256_set1_pd(-0.0), a);
+#else
+  return lanes_max(a, -a);
+#endif
+}
 /// Stores the four lanes at `to` (which has room for them).
 inline void store_lanes(double* to, Lanes v) {
   std::memcpy(to, &v, sizeof v);
@@ -124,7 +132,7 @@ struct Gimp {
     const Lanes one = {1.0, 1.0, 1.0, 1.0};
     const Lanes hi = lanes_min(lanes_max(d + lp, -one), one);
     const Lanes lo = lanes_min(lanes_max(d - lp, -one), one);
-    const Lanes ahi = lanes_max(hi, -hi), alo = lanes_max(lo, -lo);
+    const Lanes ahi = lanes_abs(hi), alo = lanes_abs(lo);
     w = ((hi - lo) - 0.5 * (hi * ahi - lo * alo)) * inv;
     dw = (alo - ahi) * inv;
   }
