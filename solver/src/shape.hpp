@@ -6,7 +6,9 @@
 // and an `eval` (K = 2) or `eval_lanes` (K = 3, the K weights in one
 // four-lane vector) that, given that cell, returns the first node of the
 // stencil and the K weights and derivatives (per cell unit). The tensor
-// product over axes is formed by `Stencil`. Locating (a truncation, a clamp, an integer
+// product over axes is formed by `Stencil`; for the 3-node shape functions in
+// 2D and 3D the phases do not form it: they sum row by row from the
+// per-axis factors (`Stencil::Axes`, `factorised`). Locating (a truncation, a clamp, an integer
 // conversion per axis) is about a third of a stencil's cost; the time step
 // locates once per step and reuses the cells while particles do not move.
 // Everything is inline, branch-light and allocation-free: it runs several
