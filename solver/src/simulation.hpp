@@ -118,9 +118,8 @@ class Simulation {
                                              double dt);
   void update_nodal_pressure(double t_new, double dt);
   void update_particle_pressure_and_position(std::size_t begin, std::size_t end, double dt);
-  __attribute__((always_inline)) inline void move_particle(std::size_t p, const StencilT& s,
-                                                           double dt);
-  /// move_particle's second half: x += dt v, v = sum N_i v_i gathered by the caller.
+  /// Moves particle p: x += dt v, v = sum N_i v_i (the Lagrangian nodal
+  /// velocity) gathered by the caller.
   __attribute__((always_inline)) inline void displace_particle(std::size_t p, Vec v, double dt);
   /// A particle outside the grid: back onto the face if a wall holds it there.
   bool return_to_wall(std::size_t p);

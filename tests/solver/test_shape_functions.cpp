@@ -169,23 +169,38 @@ TEST(ShapeFunctions, BSplineEqualsItsClosedFormAndStaysWholeAtTheGridEdge) {
   EXPECT_LT(worst_grad_sum, round_off);
 }
 
+/// The grid of the 2D and 3D stencil checks: unequal cells and spacings
+/// per axis, nodes numbered axis 0 first.
+struct TestGrid {
+  int cells[3] = {7, 9, 6};
+  double origin[3] = {-1.0, 0.5, 2.0};
+  double h[3] = {0.5, 0.25, 2.0};
+  double inv_h[3] = {1.0 / h[0], 1.0 / h[1], 1.0 / h[2]};
+  std::int64_t stride[3] = {1, cells[0] + 1, std::int64_t{cells[0] + 1} * (cells[1] + 1)};
+  /// The point at xi cell units from the origin.
+  template <int Dim>
+  Eigen::Matrix<double, Dim, 1> point(const double* xi) const {
+    Eigen::Matrix<double, Dim, 1> x;
+    for (int a = 0; a < Dim; ++a) x[a] = origin[a] + xi[a] * h[a];
+    return x;
+  }
+};
+
 /// In 2D and 3D every node's weight and gradient are products of the 1D
 /// ones (computed here by the 1D stencil), the nodes numbered axis 0 first.
 template <int Dim, class Shape>
 void expect_tensor_product(Box b) {
   using StencilT = Stencil<Dim, Shape>;
-  const int cells[3] = {7, 9, 6};
-  const double origin[3] = {-1.0, 0.5, 2.0}, h[3] = {0.5, 0.25, 2.0};
-  double inv_h[3];
-  for (int a = 0; a < 3; ++a) inv_h[a] = 1.0 / h[a];
-  const std::int64_t stride[3] = {1, cells[0] + 1, std::int64_t{cells[0] + 1} * (cells[1] + 1)};
+  const TestGrid g;
+  const int* const cells = g.cells;
+  const double* const inv_h = g.inv_h;
+  const std::int64_t* const stride = g.stride;
   const double where[4][3] = {
       {0.3, 0.6, 0.1}, {2.77, 4.1, 3.3}, {6.9, 8.95, 5.999}, {3.5, 4.5, 2.5}};
   for (const auto& xi : where) {
-    Eigen::Matrix<double, Dim, 1> x;
-    for (int a = 0; a < Dim; ++a) x[a] = origin[a] + xi[a] * h[a];
+    const Eigen::Matrix<double, Dim, 1> x = g.point<Dim>(xi);
     StencilT s;
-    s.template compute<true>(x, origin, inv_h, cells, stride, b);
+    s.template compute<true>(x, g.origin, inv_h, cells, stride, b);
     std::array<Stencil<1, Shape>, Dim> axis;
     for (int a = 0; a < Dim; ++a) axis[a] = stencil_1d<Shape>(xi[a], cells[a], b);
     int n = 0;
@@ -231,21 +246,19 @@ template <int Dim, class Shape>
 void expect_rows_match_stencil(Box b) {
   using StencilT = Stencil<Dim, Shape>;
   static_assert(StencilT::factorised);
-  const int cells[3] = {7, 9, 6};
-  const double origin[3] = {-1.0, 0.5, 2.0}, h[3] = {0.5, 0.25, 2.0};
-  double inv_h[3];
-  for (int a = 0; a < 3; ++a) inv_h[a] = 1.0 / h[a];
-  const std::int64_t stride[3] = {1, cells[0] + 1, std::int64_t{cells[0] + 1} * (cells[1] + 1)};
+  const TestGrid g;
+  const int* const cells = g.cells;
+  const double* const inv_h = g.inv_h;
+  const std::int64_t* const stride = g.stride;
   const double where[5][3] = {
       {0.3, 0.6, 0.1}, {2.77, 4.1, 3.3}, {6.9, 8.95, 5.999}, {3.5, 4.5, 2.5}, {0.01, 8.6, 5.4}};
   for (const auto& xi : where) {
-    Eigen::Matrix<double, Dim, 1> x;
-    for (int a = 0; a < Dim; ++a) x[a] = origin[a] + xi[a] * h[a];
+    const Eigen::Matrix<double, Dim, 1> x = g.point<Dim>(xi);
     StencilT s;
     std::int32_t cell[Dim];
-    s.template compute<true, false>(x, origin, inv_h, cells, stride, b, cell);
+    s.template compute<true, false>(x, g.origin, inv_h, cells, stride, b, cell);
     typename StencilT::Axes f;
-    StencilT::template axes<true>(x, origin, inv_h, cells, stride, b, cell, f);
+    StencilT::template axes<true>(x, g.origin, inv_h, cells, stride, b, cell, f);
     EXPECT_EQ(f.first(), s.node[0]);
     EXPECT_EQ(f.last(stride), s.node[StencilT::N - 1]);
     int n = 0;

@@ -58,20 +58,11 @@ inline void Simulation<Dim, Shape>::update_particle_velocities_and_remap(const O
   }
 }
 
-/// Moves the particle with the Lagrangian nodal velocity. One test per
+/// Moves the particle with the Lagrangian nodal velocity v. One test per
 /// axis catches both failures: a non-finite position (the comparisons are
 /// false for NaN) and a position outside the grid. A non-finite particle
 /// velocity, stress or force makes the nodal velocities, hence the
 /// position, non-finite in the same or the next step.
-template <int Dim, class Shape>
-__attribute__((always_inline)) inline void Simulation<Dim, Shape>::move_particle(std::size_t p,
-                                                                                 const StencilT& s,
-                                                                                 double dt) {
-  Vec v = Vec::Zero();
-  for (int k = 0; k < StencilT::N; ++k) v += s.w[k] * grid_.velocity[s.node[k]];
-  displace_particle(p, v, dt);
-}
-
 template <int Dim, class Shape>
 __attribute__((always_inline)) inline void Simulation<Dim, Shape>::displace_particle(std::size_t p,
                                                                                      Vec v,

@@ -82,10 +82,12 @@ inline void Simulation<Dim, Shape>::update_particle_pressure_and_position(std::s
   typename StencilT::Axes ahead[2];
   for (std::size_t p = begin; p < end; ++p) {
     const auto& f = axes_ahead<true>(p, begin, end, ahead);
+    const bool saturated = constants_[particles_.material[p]].saturated;
+    // Weights only: this pass needs no gradient. v: the Lagrangian nodal
+    // velocity at the particle, which moves it.
+    double dp = 0.0, p_new = 0.0;
+    Vec v = Vec::Zero();
     if constexpr (StencilT::factorised) {  // row by row (StencilT::Axes)
-      const bool saturated = constants_[particles_.material[p]].saturated;
-      double dp = 0.0, p_new = 0.0;
-      Vec v = Vec::Zero();
       f.for_rows(grid_.stride, [&](std::int64_t row, double wr, const auto&) {
         if (saturated) {
           const double* const d = &grid_.dp[row];
@@ -96,27 +98,23 @@ inline void Simulation<Dim, Shape>::update_particle_pressure_and_position(std::s
         }
         f.add_scaled(v, wr, f.row_sum(f.w[0], &grid_.velocity[row]));
       });
+    } else {
+      stencil_in_step<false, true>(p, s);
       if (saturated) {
-        particles_.pressure[p] += dp;
-        particles_.pressure_out[p] = p_new;
-        if (!std::isfinite(p_new)) fail_nonfinite(p, "pore pressure");
+        for (int k = 0; k < StencilT::N; ++k) {
+          const std::int64_t i = s.node[k];
+          dp += s.w[k] * grid_.dp[i];
+          p_new += s.w[k] * (grid_.pressure[i] + grid_.dp[i]);
+        }
       }
-      displace_particle(p, v, dt);
-      continue;
+      for (int k = 0; k < StencilT::N; ++k) v += s.w[k] * grid_.velocity[s.node[k]];
     }
-    stencil_in_step<false, true>(p, s);
-    if (constants_[particles_.material[p]].saturated) {
-      double dp = 0.0, p_new = 0.0;  // weights only: this pass needs no gradient
-      for (int k = 0; k < StencilT::N; ++k) {
-        const std::int64_t i = s.node[k];
-        dp += s.w[k] * grid_.dp[i];
-        p_new += s.w[k] * (grid_.pressure[i] + grid_.dp[i]);
-      }
+    if (saturated) {
       particles_.pressure[p] += dp;
       particles_.pressure_out[p] = p_new;
       if (!std::isfinite(p_new)) fail_nonfinite(p, "pore pressure");
     }
-    move_particle(p, s, dt);
+    displace_particle(p, v, dt);
   }
 }
 

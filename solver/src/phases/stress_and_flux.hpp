@@ -35,7 +35,7 @@ inline void Simulation<Dim, Shape>::update_particle_stress_and_fluid_flux(const 
     Mat grad_v = Mat::Zero();
     // Dry runs move the particle in this phase: its velocity is gathered
     // from the same nodes in the same loop (the same sums, in the same order,
-    // as move_particle's).
+    // as update_particle_pressure_and_position's).
     Vec v_move = Vec::Zero();
     if constexpr (StencilT::factorised) {
       // Row by row (StencilT::Axes): sums along axis 0 with the axis-0
