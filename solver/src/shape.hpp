@@ -39,6 +39,12 @@ namespace hmpm::shape {
 /// the stencil per instruction (lane 3 is padding).
 using Lanes = double __attribute__((vector_size(32)));
 
+/// Two doubles, and two or four cell indices: the axes of a 2D or 3D
+/// stencil in GIMP's eval_axes.
+using Lanes2 = double __attribute__((vector_size(16)));
+using Ints2 = std::int32_t __attribute__((vector_size(8)));
+using Ints4 = std::int32_t __attribute__((vector_size(16)));
+
 #ifdef __AVX__
 // vmaxpd/vminpd (GCC otherwise compiles the clamps below to a compare and a
 // blend); the operand order gives the ternaries' result for NaN as well.
@@ -48,22 +54,104 @@ inline Lanes lanes_max(Lanes a, Lanes b) {
 inline Lanes lanes_min(Lanes a, Lanes b) {
   return _mm256_min_pd(b, a);
 }
-#else
-inline Lanes lanes_max(Lanes a, Lanes b) {
-  return a < b ? b : a;
+inline Lanes2 lanes_max(Lanes2 a, Lanes2 b) {
+  return _mm_max_pd(b, a);
 }
-inline Lanes lanes_min(Lanes a, Lanes b) {
-  return b < a ? b : a;
-}
-#endif
 /// |a| lane by lane (the sign bit cleared: one vandpd, not a negation and a maximum).
 inline Lanes lanes_abs(Lanes a) {
-#ifdef __AVX__
   return _mm256_andnot_pd(_mm256_set1_pd(-0.0), a);
+}
+inline Lanes2 lanes_abs(Lanes2 a) {
+  return _mm_andnot_pd(_mm_set1_pd(-0.0), a);
+}
+/// |a| with the sign of b, lane by lane.
+inline Lanes lanes_copysign(Lanes a, Lanes b) {
+  const Lanes sign = _mm256_set1_pd(-0.0);
+  return _mm256_or_pd(_mm256_andnot_pd(sign, a), _mm256_and_pd(sign, b));
+}
+inline Lanes2 lanes_copysign(Lanes2 a, Lanes2 b) {
+  const Lanes2 sign = _mm_set1_pd(-0.0);
+  return _mm_or_pd(_mm_andnot_pd(sign, a), _mm_and_pd(sign, b));
+}
+/// The cell indices as doubles (the padding lanes too).
+inline Lanes2 to_doubles(Ints2 i) {
+  __m128i v;
+  std::memcpy(&v, &i, sizeof i);  // the upper half is never read
+  return _mm_cvtepi32_pd(v);
+}
+inline Lanes to_doubles(Ints4 i) {
+  return _mm256_cvtepi32_pd(reinterpret_cast<__m128i>(i));
+}
+/// Whether any of the first Count lanes of a comparison's mask is set.
+template <int Count, class Mask>
+inline bool any_lane(Mask m) {
+  if constexpr (sizeof(Mask) == 16)
+    return (_mm_movemask_pd(reinterpret_cast<__m128d>(m)) & ((1 << Count) - 1)) != 0;
+  else
+    return (_mm256_movemask_pd(reinterpret_cast<__m256d>(m)) & ((1 << Count) - 1)) != 0;
+}
 #else
+inline Lanes2 to_doubles(Ints2 i) {
+  return __builtin_convertvector(i, Lanes2);
+}
+inline Lanes to_doubles(Ints4 i) {
+  return __builtin_convertvector(i, Lanes);
+}
+template <int Count, class Mask>
+inline bool any_lane(Mask m) {
+  bool any = false;
+  for (int a = 0; a < Count; ++a) any |= m[a] != 0;
+  return any;
+}
+template <class V>
+inline V lanes_max(V a, V b) {
+  return a < b ? b : a;
+}
+template <class V>
+inline V lanes_min(V a, V b) {
+  return b < a ? b : a;
+}
+template <class V>
+inline V lanes_abs(V a) {
   return lanes_max(a, -a);
+}
+template <class V>
+inline V lanes_copysign(V a, V b) {
+  V r;
+  for (int i = 0; i < static_cast<int>(sizeof(V) / sizeof(double)); ++i)
+    r[i] = std::copysign(a[i], b[i]);
+  return r;
+}
+#endif
+/// v in every lane.
+inline Lanes splat(double v) {
+  return Lanes{v, v, v, v};
+}
+/// a b + c in one rounding where the machine has FMA, else in two. The
+/// shape functions write their multiply-adds out with these: GCC contracts
+/// a product and a sum into one FMA or not by the code around them, so
+/// the same formula inlined in two places (the first particle of a loop
+/// and the ones after it) could round differently.
+inline double fused(double a, double b, double c) {
+#ifdef __FMA__
+  return std::fma(a, b, c);
+#else
+  return a * b + c;
 #endif
 }
+#ifdef __FMA__
+inline Lanes fused(Lanes a, Lanes b, Lanes c) {
+  return _mm256_fmadd_pd(a, b, c);
+}
+inline Lanes2 fused(Lanes2 a, Lanes2 b, Lanes2 c) {
+  return _mm_fmadd_pd(a, b, c);
+}
+#else
+template <class V>
+inline V fused(V a, V b, V c) {
+  return a * b + c;
+}
+#endif
 /// Stores the four lanes at `to` (which has room for them).
 inline void store_lanes(double* to, Lanes v) {
   std::memcpy(to, &v, sizeof v);
@@ -106,13 +194,27 @@ struct Linear {
 /// half-length `half_length` (cell units) convolved with the hat function.
 /// 3 nodes per axis.
 ///
-/// Branch-free and vectorised over the three nodes: the convolution is the
-/// difference of the hat's antiderivative H at the box's two ends, divided
-/// by the box's length, and H on the clamped argument c in [-1, 1] is one
-/// polynomial, H(c) = 1/2 + c - c|c|/2 (0 left of the hat, 1 right of it);
-/// the derivative is the difference of the hat's values, 1 - |c|. (The
-/// piecewise form, four cases per node, compiled to six unpredictable
-/// branches per axis.)
+/// With s the particle's offset from the middle node (cell units; in
+/// [-1/2, 1/2) away from the grid's edges), while the box reaches neither
+/// outer node (|s| <= 1 - lp: always there when lp <= 1/2, the sub-cell box
+/// of one or more particles per cell) the three weights are one quadratic
+/// form in s and one function g of |s|:
+///   g = |s| + m^2 / (2 lp),  m = max(lp - |s|, 0),
+///   w = (g/2 - s/2, 1 - g, g/2 + s/2),  dw = (g'/2 - 1/2, -g', g'/2 + 1/2),
+///   g' = sign(s) (1 - m / lp).
+/// (While the box covers the middle node, |s| < lp, g = (s^2 + lp^2) / (2 lp)
+/// and w is the piecewise form's quadratic case; beside it, g = |s| and w is
+/// the hat's. g is continuous with its slope, so are w and dw.) This costs a
+/// few scalar operations, shared by the axes in 2D and 3D (`eval_axes`), and
+/// per axis two vector multiply-adds; the older difference of two clamped
+/// antiderivatives cost about 16 vector operations per axis and pass.
+/// Otherwise (the first node clamped at the grid's edges, or a box wider than
+/// a cell) `general`: the convolution as the difference of the hat's
+/// antiderivative H at the box's two ends divided by the box's length, with
+/// H on the clamped argument c in [-1, 1] one polynomial,
+/// H(c) = 1/2 + c - c|c|/2, and the derivative the difference of the hat's
+/// values, 1 - |c|. Each node's weight is exact in both; a box reaching past
+/// the grid's edge loses the part on the missing node.
 struct Gimp {
   static constexpr int K = 3;
   /// Smallest half-length used (cell units): a points body's particle may
@@ -123,14 +225,121 @@ struct Gimp {
     // NOLINTNEXTLINE(bugprone-incorrect-roundings)
     return std::clamp(static_cast<int>(xi + 0.5) - 1, 0, cells - 2);
   }
-  /// Weights (lanes 0..2) and derivatives per cell unit of nodes b, b+1, b+2.
-  /// The box's half-length is at least min_half_length (setup.hpp).
-  static inline void eval_lanes(double xi, int b, int /*cells*/, Box box, int& base, Lanes& w,
+  /// locate, lane by lane (the same truncation, rounding and clamp).
+  template <class V, class I>
+  static inline I locate_lanes(V xi, I last) {
+#ifdef __AVX__
+    __m128i c, top;
+    if constexpr (sizeof(V) == 16)
+      c = _mm_cvttpd_epi32(xi + 0.5);
+    else
+      c = _mm256_cvttpd_epi32(xi + 0.5);
+    std::memcpy(&top, &last, sizeof last);  // an Ints2 fills the lower half only
+    c = _mm_max_epi32(_mm_min_epi32(_mm_sub_epi32(c, _mm_set1_epi32(1)), top), _mm_setzero_si128());
+    I out;
+    std::memcpy(&out, &c, sizeof out);
+    return out;
+#else
+    I out;
+    for (int a = 0; a < static_cast<int>(sizeof(I) / sizeof(std::int32_t)); ++a)
+      out[a] = locate(xi[a], last[a] + 2);
+    return out;
+#endif
+  }
+  /// Weights (lanes 0..2) and derivatives per cell unit of nodes b, b+1, b+2;
+  /// f: the particle's offset from node b (cell units). The box's
+  /// half-length is at least min_half_length (setup.hpp).
+  static inline void eval_lanes(double f, int b, int /*cells*/, Box box, int& base, Lanes& w,
                                 Lanes& dw) {
     base = b;
     const double lp = box.half_length, inv = box.inverse;
-    const Lanes node = {0.0, 1.0, 2.0, 3.0};
-    const Lanes d = (xi - b) - node;  // particle minus node, cell units
+    const double s = f - 1.0;
+    const double as = std::fabs(s);
+    if (as > 1.0 - lp) [[unlikely]] {
+      general(s, lp, inv, w, dw);
+      return;
+    }
+    const double m = std::max(lp - as, 0.0), mi = m * inv;
+    const double g = fused(m, mi, as);
+    w = fused(splat(g), half, fused(splat(s), odd, middle));
+    dw = fused(splat(std::copysign(fused(-2.0, mi, 1.0), s)), half, odd);
+  }
+
+  /// The weights and derivatives (Grad) of every axis of a 2D or 3D stencil,
+  /// those of eval_lanes: the scalar part of the formula runs once for all
+  /// the axes, in the lanes of one vector (two in 2D, four in 3D). x, origin,
+  /// inv_h, cells: per axis, as in Stencil::axes; `cell` holds each axis's
+  /// cell (its first node) with Located, and receives it without. Returns
+  /// the cells.
+  template <int Dim, bool Grad, bool Located, class Vec>
+  __attribute__((always_inline)) static inline auto eval_axes(const Vec& x, const double* origin,
+                                                              const double* inv_h, const int* cells,
+                                                              std::int32_t* cell, Box box, Lanes* w,
+                                                              Lanes* dw) {
+    static_assert(Dim == 2 || Dim == 3);
+    using V = std::conditional_t<Dim == 2, Lanes2, Lanes>;
+    using I = std::conditional_t<Dim == 2, Ints2, Ints4>;
+    // The Dim values at v in one vector (the coordinates, or the cells);
+    // lane by lane in 3D: a copy of three values into a vector goes through
+    // memory, and the vector's load then waits for the stores to retire.
+    auto lanes_of = [](const auto* v) {
+      using T = std::remove_cv_t<std::remove_pointer_t<decltype(v)>>;
+      using Out = std::conditional_t<std::is_same_v<T, double>, V, I>;
+      if constexpr (Dim == 2) {
+        Out out;
+        std::memcpy(&out, v, sizeof out);
+        return out;
+      } else {
+        return Out{v[0], v[1], v[2], T{}};
+      }
+    };
+    const V xv = lanes_of(x.data()), ov = lanes_of(origin), hv = lanes_of(inv_h);
+    I bv{};
+    if constexpr (Located) {
+      bv = lanes_of(cell);
+    } else {  // locate, lane by lane (in registers: the cells stored are not read back)
+      bv = locate_lanes((xv - ov) * hv, lanes_of(cells) - 2);
+      std::memcpy(cell, &bv, Dim * sizeof(std::int32_t));
+    }
+    const V f = fused(xv - ov, hv, -to_doubles(bv));  // offset from the cell, one rounding
+    const V s = f - 1.0;
+    const V as = lanes_abs(s);
+    const double lp = box.half_length, inv = box.inverse;
+    if (any_lane<Dim>(as > 1.0 - lp)) [[unlikely]] {
+      irregular_axes<Dim, Grad>(f, bv, lp, inv, w, dw);
+      return bv;
+    }
+    const V zero{};
+    const V m = lanes_max(lp - as, zero), mi = m * inv;
+    const V g = fused(m, mi, as);
+    for (int a = 0; a < Dim; ++a) w[a] = fused(splat(g[a]), half, fused(splat(s[a]), odd, middle));
+    if constexpr (Grad) {
+      const V slope = lanes_copysign(fused(zero - 2.0, mi, zero + 1.0), s);
+      for (int a = 0; a < Dim; ++a) dw[a] = fused(splat(slope[a]), half, odd);
+    }
+    return bv;
+  }
+
+ private:
+  static constexpr Lanes half = {0.5, -1.0, 0.5, 0.0}, odd = {-0.5, 0.0, 0.5, 0.0};
+  static constexpr Lanes middle = {0.0, 1.0, 0.0, 0.0};
+
+  /// eval_axes's axes one by one (eval_lanes), when one of them is not regular.
+  template <int Dim, bool Grad, class V, class I>
+  __attribute__((noinline)) static void irregular_axes(V f, I b, double lp, double inv, Lanes* w,
+                                                       Lanes* dw) {
+    for (int a = 0; a < Dim; ++a) {
+      int base;
+      Lanes unused;
+      eval_lanes(f[a], b[a], 0, {lp, inv}, base, w[a], Grad ? dw[a] : unused);
+    }
+  }
+
+  /// Any offset and box: node by node, the difference of the antiderivative.
+  __attribute__((noinline)) static void general(double s, double lp, double inv, Lanes& w,
+                                                Lanes& dw) {
+    const Lanes node = {-1.0, 0.0, 1.0, 2.0};
+    const Lanes d = s - node;  // particle minus node, cell units
     const Lanes one = {1.0, 1.0, 1.0, 1.0};
     const Lanes hi = lanes_min(lanes_max(d + lp, -one), one);
     const Lanes lo = lanes_min(lanes_max(d - lp, -one), one);
@@ -152,14 +361,13 @@ struct BSpline {
   /// With f = xi - b in [0.5, 1.5) and t = (1.5 - f, f - 1, f - 0.5) (each
   /// lane one exact sign flip and one subtraction):
   /// w = (0.5 t0^2, 0.75 - t1^2, 0.5 t2^2), dw = (-t0, -2 t1, t2).
-  static inline void eval_lanes(double xi, int b, int cells, Box /*box*/, int& base, Lanes& w,
+  static inline void eval_lanes(double f, int b, int cells, Box /*box*/, int& base, Lanes& w,
                                 Lanes& dw) {
-    const double f = xi - b;
     const Lanes sign = {-1.0, 1.0, 1.0, 0.0}, shift = {1.5, -1.0, -0.5, 0.0};
     const Lanes square = {0.5, -1.0, 0.5, 0.0}, constant = {0.0, 0.75, 0.0, 0.0};
     const Lanes slope = {-1.0, -2.0, 1.0, 0.0};
-    const Lanes t = shift + sign * f;
-    w = square * t * t + constant;
+    const Lanes t = fused(sign, splat(f), shift);
+    w = fused(square * t, t, constant);
     dw = slope * t;
     if (b < 0) [[unlikely]] {  // ghost node -1 folded into node 0
       base = 0;
@@ -219,6 +427,13 @@ struct Stencil {
       compute_lanes<Grad, Located>(x, origin, inv_h, cells, stride, box, cell);
     else
       compute_scalar<Grad, Located>(x, origin, inv_h, cells, stride, box, cell);
+  }
+
+  /// A particle's offset from its cell's first node b in cell units, from
+  /// its offset d from the grid's origin in metres: d inv_h - b in one
+  /// rounding (3-node shape functions).
+  static inline double offset(double d, double inv_h, int b) {
+    return fused(d, inv_h, -static_cast<double>(b));
   }
 
   /// Whether the phases sum this stencil row by row from its factors
@@ -307,19 +522,30 @@ struct Stencil {
     }
   };
 
-  /// The factors of x's stencil; Located as in compute.
-  template <bool Located, class Vec>
+  /// The factors of x's stencil; Located as in compute. With Grad = false
+  /// the derivatives are left unset (passes that need weights only).
+  template <bool Located, bool Grad = true, class Vec>
   __attribute__((always_inline)) static inline void axes(const Vec& x, const double* origin,
                                                          const double* inv_h, const int* cells,
                                                          const std::int64_t* stride, Box box,
                                                          std::int32_t* cell, Axes& f) {
     static_assert(K == 3);
     int base[Dim];
-    for (int a = 0; a < Dim; ++a) {
-      const double xi = (x[a] - origin[a]) * inv_h[a];
-      if constexpr (!Located) cell[a] = Shape::locate(xi, cells[a]);
-      Shape::eval_lanes(xi, cell[a], cells[a], box, base[a], f.w[a], f.dw[a]);
-      f.dw[a] *= inv_h[a];
+    if constexpr (std::is_same_v<Shape, Gimp>) {  // all the axes at once
+      const auto b = Shape::template eval_axes<Dim, Grad, Located>(x, origin, inv_h, cells, cell,
+                                                                   box, f.w, f.dw);
+      for (int a = 0; a < Dim; ++a) base[a] = b[a];
+      if constexpr (Grad)
+        for (int a = 0; a < Dim; ++a) f.dw[a] *= inv_h[a];
+    } else {
+      for (int a = 0; a < Dim; ++a) {
+        const double d = x[a] - origin[a];
+        if constexpr (!Located) cell[a] = Shape::locate(d * inv_h[a], cells[a]);
+        Lanes unused;
+        Shape::eval_lanes(offset(d, inv_h[a], cell[a]), cell[a], cells[a], box, base[a], f.w[a],
+                          Grad ? f.dw[a] : unused);
+        if constexpr (Grad) f.dw[a] *= inv_h[a];
+      }
     }
     f.node0 = base[0];
     for (int a = 1; a < Dim; ++a) f.node0 += base[a] * stride[a];
@@ -396,9 +622,10 @@ struct Stencil {
     int base[Dim];
     Lanes wa[Dim], da[Dim];
     for (int a = 0; a < Dim; ++a) {
-      const double xi = (x[a] - origin[a]) * inv_h[a];
-      if constexpr (!Located) cell[a] = Shape::locate(xi, cells[a]);
-      Shape::eval_lanes(xi, cell[a], cells[a], box, base[a], wa[a], da[a]);
+      const double d = x[a] - origin[a];
+      if constexpr (!Located) cell[a] = Shape::locate(d * inv_h[a], cells[a]);
+      Shape::eval_lanes(offset(d, inv_h[a], cell[a]), cell[a], cells[a], box, base[a], wa[a],
+                        da[a]);
       if constexpr (Grad) da[a] *= inv_h[a];
     }
     if constexpr (Dim == 1) {

@@ -143,6 +143,45 @@ TEST(ShapeFunctions, GimpDerivativeIsTheSlopeOfItsWeight) {
   }
 }
 
+TEST(ShapeFunctions, GimpNextToTheGridEdgeAndWiderThanACellWeighsEachNodeExactly) {
+  // The first node is clamped at the edges (offset from the middle node
+  // beyond 1/2), and a box wider than a cell (a points body's large
+  // particle) reaches past the outer nodes: both take the general form.
+  // Each of the stencil's nodes keeps its exact weight; the part of the
+  // box on a node outside the grid or outside the stencil is not mapped.
+  // The reference is the convolution itself, integrated exactly: the hat
+  // is linear between its kinks at -1, 0 and 1, so the trapezoidal rule on
+  // the box split at the kinks is exact (the piecewise form above holds
+  // for lp <= 1/2 only).
+  auto convolution = [](double d, double lp) {
+    auto hat = [](double y) { return std::max(0.0, 1.0 - std::abs(y)); };
+    std::vector<double> cuts = {d - lp};
+    for (double kink : {-1.0, 0.0, 1.0})
+      if (kink > d - lp && kink < d + lp) cuts.push_back(kink);
+    cuts.push_back(d + lp);
+    double integral = 0.0;
+    for (std::size_t i = 0; i + 1 < cuts.size(); ++i)
+      integral += 0.5 * (hat(cuts[i]) + hat(cuts[i + 1])) * (cuts[i + 1] - cuts[i]);
+    return Ref{integral / (2.0 * lp), (hat(d + lp) - hat(d - lp)) / (2.0 * lp)};
+  };
+  const int cells = 8;
+  for (double lp : {0.5, 0.25, 0.1, 0.7, 1.0}) {
+    double worst_w = 0.0, worst_dw = 0.0;
+    for (int i = 0; i <= 8000; ++i) {
+      const double xi = cells * i / 8000.0;
+      if (lp <= 0.5 && xi > 1.5 && xi < cells - 1.5) continue;  // the test above
+      const auto s = stencil_1d<Gimp>(xi, cells, box(lp));
+      for (int k = 0; k < 3; ++k) {
+        const Ref r = convolution(xi - static_cast<double>(s.node[k]), lp);
+        worst_w = std::max(worst_w, std::abs(s.w[k] - r.w));
+        worst_dw = std::max(worst_dw, std::abs(s.dw[0][k] - r.dw));
+      }
+    }
+    EXPECT_LT(worst_w, round_off) << "lp " << lp;
+    EXPECT_LT(worst_dw, round_off) << "lp " << lp;
+  }
+}
+
 TEST(ShapeFunctions, BSplineEqualsItsClosedFormAndStaysWholeAtTheGridEdge) {
   const int cells = 8;
   double worst_w = 0.0, worst_dw = 0.0, worst_sum = 0.0, worst_grad_sum = 0.0;
@@ -257,8 +296,27 @@ void expect_rows_match_stencil(Box b) {
     StencilT s;
     std::int32_t cell[Dim];
     s.template compute<true, false>(x, g.origin, inv_h, cells, stride, b, cell);
-    typename StencilT::Axes f;
+    typename StencilT::Axes f, located_here;
     StencilT::template axes<true>(x, g.origin, inv_h, cells, stride, b, cell, f);
+    // Locating in the same call (the first pass of a step) finds the same
+    // cells and factors.
+    std::int32_t cell_here[Dim];
+    StencilT::template axes<false>(x, g.origin, inv_h, cells, stride, b, cell_here, located_here);
+    // Each axis's factors are those of the one-axis evaluation, bit for bit
+    // (GIMP evaluates all the axes at once in 2D and 3D).
+    for (int a = 0; a < Dim; ++a) {
+      EXPECT_EQ(cell_here[a], cell[a]);
+      int base = 0;
+      hmpm::shape::Lanes w1, dw1;
+      Shape::eval_lanes(StencilT::offset(x[a] - g.origin[a], inv_h[a], cell[a]), cell[a], cells[a],
+                        b, base, w1, dw1);
+      for (int i = 0; i < Shape::K; ++i) {
+        EXPECT_EQ(located_here.w[a][i], f.w[a][i]);
+        EXPECT_EQ(located_here.dw[a][i], f.dw[a][i]);
+        EXPECT_EQ(f.w[a][i], w1[i]);
+        EXPECT_EQ(f.dw[a][i], dw1[i] * inv_h[a]);
+      }
+    }
     EXPECT_EQ(f.first(), s.node[0]);
     EXPECT_EQ(f.last(stride), s.node[StencilT::N - 1]);
     int n = 0;

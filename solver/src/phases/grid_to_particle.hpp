@@ -22,7 +22,7 @@ inline void Simulation<Dim, Shape>::update_particle_velocities_and_remap(const O
   // A local copy: the compiler otherwise reloads the pointer at every node
   // (Eigen's vector stores may alias it).
   Vec* const remap_out = at<nodal::remap>(out);
-  typename StencilT::Axes ahead[2];
+  AxesAhead ahead;
   // The same for the arrays read and written per particle (the stores to
   // remap_out may alias them for the compiler, which then reloads the
   // particle's velocity it has just stored).
@@ -30,7 +30,7 @@ inline void Simulation<Dim, Shape>::update_particle_velocities_and_remap(const O
   const double* const mass = particles_.mass.data();
   Vec* const velocity = particles_.v.data();
   for (std::size_t p = begin; p < end; ++p) {
-    const auto& f = axes_ahead<true>(p, begin, end, ahead);
+    const auto& f = axes_ahead</*Located=*/true, /*Grad=*/false>(p, begin, end, ahead);
     if constexpr (StencilT::factorised) {  // row by row (StencilT::Axes)
       Vec a = Vec::Zero();
       f.for_rows(grid_.stride, [&](std::int64_t row, double wr, const auto&) {

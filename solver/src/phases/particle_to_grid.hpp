@@ -98,7 +98,7 @@ inline void Simulation<Dim, Shape>::map_particles_to_grid_by_rows(const Out& out
     NodeRange touched{grid_.count, -1};
     using shape::Lanes;
     NodeRecord* const records = out.records;
-    typename StencilT::Axes ahead[2];
+    AxesAhead ahead;
     double* const storage_out = at<nodal::storage>(out);
     double* const pressure_out = at<nodal::pressure>(out);
     for (std::size_t p = begin; p < end; ++p) {

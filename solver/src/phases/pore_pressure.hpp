@@ -30,7 +30,7 @@ template <int Dim, class Shape>
 inline void Simulation<Dim, Shape>::map_pore_pressure_force(const Out& out, std::size_t begin,
                                                             std::size_t end) {
   StencilT s;
-  typename StencilT::Axes ahead[2];
+  AxesAhead ahead;
   Vec* const force_out = at<nodal::force>(out);
   for (std::size_t p = begin; p < end; ++p) {
     const auto& f = axes_ahead<true>(p, begin, end, ahead);
@@ -79,9 +79,9 @@ inline void Simulation<Dim, Shape>::update_particle_pressure_and_position(std::s
                                                                           std::size_t end,
                                                                           double dt) {
   StencilT s;
-  typename StencilT::Axes ahead[2];
+  AxesAhead ahead;
   for (std::size_t p = begin; p < end; ++p) {
-    const auto& f = axes_ahead<true>(p, begin, end, ahead);
+    const auto& f = axes_ahead</*Located=*/true, /*Grad=*/false>(p, begin, end, ahead);
     const bool saturated = constants_[particles_.material[p]].saturated;
     // Weights only: this pass needs no gradient. v: the Lagrangian nodal
     // velocity at the particle, which moves it.

@@ -27,7 +27,7 @@ inline void Simulation<Dim, Shape>::update_particle_stress_and_fluid_flux(const 
                                                                           std::size_t end,
                                                                           double dt) {
   StencilT s;
-  typename StencilT::Axes ahead[2];
+  AxesAhead ahead;
   // A local copy (Eigen's stores may alias the pointer for the compiler).
   double* const flux_out = Fluid && ScatterFlux ? at<nodal::flux>(out) : nullptr;
   for (std::size_t p = begin; p < end; ++p) {
