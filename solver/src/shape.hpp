@@ -3,14 +3,17 @@
 // Each shape function is a small struct with a compile-time stencil width K
 // (nodes per axis), a `locate` that, for a particle coordinate expressed in
 // cell units along one axis, returns the cell its stencil is anchored to,
-// and an `eval` (K = 2) or `eval_lanes` (K = 3, the K weights in one
-// four-lane vector) that, given that cell, returns the first node of the
-// stencil and the K weights and derivatives (per cell unit). The tensor
-// product over axes is formed by `Stencil`; for the 3-node shape functions in
-// 2D and 3D the phases do not form it: they sum row by row from the
-// per-axis factors (`Stencil::Axes`, `factorised`). Locating (a truncation, a clamp, an integer
-// conversion per axis) is about a third of a stencil's cost; the time step
-// locates once per step and reuses the cells while particles do not move.
+// and an `eval` (K = 2; given the coordinate and that cell) or `eval_lanes`
+// (K = 3, the K weights in one four-lane vector; given the particle's offset
+// from the cell) that returns the first node of the stencil and the K
+// weights and derivatives (per cell unit). The tensor product over axes is
+// formed by `Stencil`; for the 3-node shape functions in 2D and 3D the
+// phases do not form it: they sum row by row from the per-axis factors
+// (`Stencil::Axes`, `factorised`), and GIMP evaluates the factors of all
+// the axes at once (`Gimp::eval_axes`). Locating (a truncation, a clamp, an
+// integer conversion per axis) is about a third of a stencil's cost; the
+// time step locates once per step and reuses the cells while particles do
+// not move.
 // Everything is inline, branch-light and allocation-free: it runs several
 // times per particle per step.
 //
