@@ -78,8 +78,8 @@ inline Lanes2 lanes_copysign(Lanes2 a, Lanes2 b) {
 }
 /// The cell indices as doubles (the padding lanes too).
 inline Lanes2 to_doubles(Ints2 i) {
-  __m128i v;
-  std::memcpy(&v, &i, sizeof i);  // the upper half is never read
+  __m128i v = _mm_setzero_si128();
+  std::memcpy(&v, &i, sizeof i);  // the lower half
   return _mm_cvtepi32_pd(v);
 }
 inline Lanes to_doubles(Ints4 i) {
@@ -232,7 +232,7 @@ struct Gimp {
   template <class V, class I>
   static inline I locate_lanes(V xi, I last) {
 #ifdef __AVX__
-    __m128i c, top;
+    __m128i c, top = _mm_setzero_si128();
     if constexpr (sizeof(V) == 16)
       c = _mm_cvttpd_epi32(xi + 0.5);
     else
