@@ -126,6 +126,13 @@ inline V lanes_copysign(V a, V b) {
   return r;
 }
 #endif
+/// The same for one value (the one-axis form of GIMP).
+inline double lanes_max(double a, double b) {
+  return std::max(a, b);
+}
+inline double lanes_copysign(double a, double b) {
+  return std::copysign(a, b);
+}
 /// v in every lane.
 inline Lanes splat(double v) {
   return Lanes{v, v, v, v};
@@ -262,10 +269,9 @@ struct Gimp {
       general(s, lp, inv, w, dw);
       return;
     }
-    const double m = std::max(lp - as, 0.0), mi = m * inv;
-    const double g = fused(m, mi, as);
-    w = fused(splat(g), half, fused(splat(s), odd, middle));
-    dw = fused(splat(std::copysign(fused(-2.0, mi, 1.0), s)), half, odd);
+    const Regular<double> r = regular(s, as, lp, inv);
+    w = weights(r.g, s);
+    dw = derivatives(r.slope);
   }
 
   /// The weights and derivatives (Grad) of every axis of a 2D or 3D stencil,
@@ -312,20 +318,36 @@ struct Gimp {
       irregular_axes<Dim, Grad>(f, bv, lp, inv, w, dw);
       return bv;
     }
-    const V zero{};
-    const V m = lanes_max(lp - as, zero), mi = m * inv;
-    const V g = fused(m, mi, as);
-    for (int a = 0; a < Dim; ++a) w[a] = fused(splat(g[a]), half, fused(splat(s[a]), odd, middle));
-    if constexpr (Grad) {
-      const V slope = lanes_copysign(fused(zero - 2.0, mi, zero + 1.0), s);
-      for (int a = 0; a < Dim; ++a) dw[a] = fused(splat(slope[a]), half, odd);
-    }
+    const Regular<V> r = regular(s, as, lp, inv);
+    for (int a = 0; a < Dim; ++a) w[a] = weights(r.g[a], s[a]);
+    if constexpr (Grad)
+      for (int a = 0; a < Dim; ++a) dw[a] = derivatives(r.slope[a]);
     return bv;
   }
 
  private:
   static constexpr Lanes half = {0.5, -1.0, 0.5, 0.0}, odd = {-0.5, 0.0, 0.5, 0.0};
   static constexpr Lanes middle = {0.0, 1.0, 0.0, 0.0};
+
+  /// g and g' of the regular form, lane by lane (V: one axis's double, or
+  /// the axes' vector), from s, |s| and the box.
+  template <class V>
+  struct Regular {
+    V g, slope;
+  };
+  template <class V>
+  static inline Regular<V> regular(V s, V as, double lp, double inv) {
+    const V zero{};
+    const V m = lanes_max(lp - as, zero), mi = m * inv;
+    return {fused(m, mi, as), lanes_copysign(fused(zero - 2.0, mi, zero + 1.0), s)};
+  }
+  /// One axis's weights and derivatives from g, s and g'.
+  static inline Lanes weights(double g, double s) {
+    return fused(splat(g), half, fused(splat(s), odd, middle));
+  }
+  static inline Lanes derivatives(double slope) {
+    return fused(splat(slope), half, odd);
+  }
 
   /// eval_axes's axes one by one (eval_lanes), when one of them is not regular.
   template <int Dim, bool Grad, class V, class I>
