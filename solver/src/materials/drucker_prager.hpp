@@ -61,13 +61,8 @@ inline DruckerPragerConstants make_drucker_prager(const hmpm::DruckerPrager& m) 
 /// else to the corner p = p_t, sqrt(J2) = k - alpha p_t (the apex when
 /// p_t = k/alpha). The deviator keeps its direction throughout. Elastic
 /// trials are left bitwise untouched. Returns ||d eps_p|| >= 0 (0 if elastic).
-/// Kept out of line (noinline): inlined into the stress phase, its cheap
-/// elastic test would be fused with the phase's arithmetic (FMA
-/// contraction), which changes the rounding of every plastic run and buys
-/// nothing measurable.
 /// Defined in drucker_prager.cpp with the region test and the tangent.
-[[gnu::noinline]] double return_drucker_prager(Voigt& stress, const Elastic& el,
-                                               const DruckerPragerConstants& dp);
+double return_drucker_prager(Voigt& stress, const Elastic& el, const DruckerPragerConstants& dp);
 
 /// Where a Drucker-Prager return lands (the tests of return_drucker_prager).
 enum class DruckerPragerRegion : std::uint8_t { elastic, cone, cut_off, corner, apex };

@@ -117,14 +117,9 @@ inline MohrCoulombConstants make_mohr_coulomb(const hmpm::MohrCoulomb& m) {
 /// (closed-form 3x3 eigen solver), returned in principal space and rotated
 /// back with the same eigenvectors (a hydrostatic result is set exactly).
 /// Returns ||d eps_p|| >= 0 (0 if elastic). Never throws, never allocates.
-/// Kept out of line (noinline): inlined into the stress phase, its cheap
-/// elastic test would be fused with the phase's arithmetic (FMA
-/// contraction), which changes the rounding of every plastic run and buys
-/// nothing measurable.
 /// Defined in mohr_coulomb.cpp, like the rest of the return (compiled once,
 /// not in every unit that includes this header).
-[[gnu::noinline]] double return_mohr_coulomb(Voigt& stress, const Elastic& el,
-                                             const MohrCoulombConstants& mc);
+double return_mohr_coulomb(Voigt& stress, const Elastic& el, const MohrCoulombConstants& mc);
 
 /// Mohr-Coulomb return with its algorithmic tangent. `stress` is the trial
 /// stress on entry and the returned stress on exit, bit for bit what

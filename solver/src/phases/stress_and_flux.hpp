@@ -136,9 +136,7 @@ inline void Simulation<Dim, Shape>::update_particle_stress_and_fluid_flux(const 
     }
     for (int c = 0; c < changed_end; ++c) particles_.strain[p][c] += de[c];
     // F = I + dt grad v, a plain matrix (its determinant inlines), filled
-    // element by element: Eigen's assignment loop may be left out of line in
-    // a translation unit whose inlining budget is spent, which changes the
-    // rounding (FMA contraction) of the determinant.
+    // element by element.
     Mat def;
     for (int a = 0; a < Dim; ++a)
       for (int b = 0; b < Dim; ++b) def(a, b) = (a == b ? 1.0 : 0.0) + dt * grad_v(a, b);
