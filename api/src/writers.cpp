@@ -126,7 +126,7 @@ void write_summary(const fs::path& path, const std::string& job_name, const RunR
   field("end_time", num(run.end_time));
   field("dt", num(run.dt));
   field("scheme", json_string(run.scheme));
-  if (run.scheme != "explicit") {
+  if (run.reports_iterations) {
     const RunResult::Iterations& it = run.iterations;
     std::string i = "{\"nonlinear\": ";
     i += std::to_string(it.nonlinear);

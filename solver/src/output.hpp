@@ -142,7 +142,7 @@ void Simulation<Dim, Shape>::sample_consolidation(RunResult::Consolidation& c,
   const FieldOfPosition& steady = job_.output.consolidation.steady_pore_pressure;
   double excess = 0.0, volume = 0.0;
   auto add = [&](std::size_t p) {
-    const MaterialConstants& m = constants_[particles_.material[p]];
+    const MaterialConstants& m = model_.constants[particles_.material[p]];
     if (!m.saturated || particles_.pressure_out.empty()) return;
     const double v0 = particles_.mass[p] / m.mixture_density;
     double ps = 0.0;

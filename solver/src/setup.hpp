@@ -23,19 +23,22 @@ namespace hmpm {
 
 template <int Dim, class Shape>
 Simulation<Dim, Shape>::Simulation(const Problem& problem, const RunOptions& options)
-    : job_(problem),
-      problem_(stage_problem(problem, 0)),
-      interrupt_(options.cancel, options.wall_time_limit_s) {
+    : job_(problem), interrupt_(options.cancel, options.wall_time_limit_s) {
+  model_.problem = stage_problem(problem, 0);
   setup_grid();
   setup_materials();
   setup_particles();
   setup_stages();
   interrupt_.stage("compiling boundaries and tractions");
   interrupt_.check();
-  constraints_ = compile_constraints<Dim>(problem_, grid_, grid_max_, fluid_, particles_);
-  tractions_ = compile_tractions<Dim>(problem_, particles_, particles_.volume, grid_);
-  if (fluid_) fluxes_ = compile_fluxes<Dim>(problem_, particles_, particles_.volume, grid_);
-  if (problem_.output.reactions_interval > 0) setup_reactions();
+  model_.constraints =
+      compile_constraints<Dim>(model_.problem, grid_, model_.grid_max, model_.fluid, particles_);
+  model_.tractions = compile_tractions<Dim>(model_.problem, particles_, particles_.volume, grid_);
+  if (model_.fluid)
+    model_.fluxes = compile_fluxes<Dim>(model_.problem, particles_, particles_.volume, grid_);
+  if (model_.problem.output.reactions_interval > 0)
+    setup_reactions<Dim>(reactions_, model_.constraints, grid_.count,
+                         model_.problem.boundaries.size());
   setup_geostatic();
   interrupt_.check();
 }
@@ -43,12 +46,12 @@ Simulation<Dim, Shape>::Simulation(const Problem& problem, const RunOptions& opt
 template <int Dim, class Shape>
 void Simulation<Dim, Shape>::setup_grid() {
   for (int a = 0; a < Dim; ++a) {
-    grid_.cells[a] = problem_.grid.cells[a];
-    grid_.origin[a] = problem_.grid.min[a];
-    grid_.h[a] = (problem_.grid.max[a] - problem_.grid.min[a]) / grid_.cells[a];
+    grid_.cells[a] = model_.problem.grid.cells[a];
+    grid_.origin[a] = model_.problem.grid.min[a];
+    grid_.h[a] = (model_.problem.grid.max[a] - model_.problem.grid.min[a]) / grid_.cells[a];
     grid_.inv_h[a] = 1.0 / grid_.h[a];
   }
-  for (int a = 0; a < Dim; ++a) grid_max_[a] = problem_.grid.max[a];
+  for (int a = 0; a < Dim; ++a) model_.grid_max[a] = model_.problem.grid.max[a];
   grid_.count = 1;
   for (int a = 0; a < Dim; ++a) {
     grid_.stride[a] = grid_.count;
@@ -58,39 +61,40 @@ void Simulation<Dim, Shape>::setup_grid() {
 
 template <int Dim, class Shape>
 void Simulation<Dim, Shape>::setup_materials() {
-  for (const Material& m : problem_.materials) {
-    constants_.push_back(material_constants(m, problem_.gravity_constant));
+  for (const Material& m : model_.problem.materials) {
+    model_.constants.push_back(material_constants(m, model_.problem.gravity_constant));
     const Hydraulic h = m.hydraulic.value_or(Hydraulic{});
-    inv_ks_.push_back(std::isinf(h.solid_bulk_modulus) ? 0.0 : 1.0 / h.solid_bulk_modulus);
-    inv_kf_.push_back(1.0 / h.fluid_bulk_modulus);
-    fluid_ = fluid_ || m.hydraulic.has_value();
-    plastic_ = plastic_ || constants_.back().model != Model::linear_elastic;
+    model_.inv_ks.push_back(std::isinf(h.solid_bulk_modulus) ? 0.0 : 1.0 / h.solid_bulk_modulus);
+    model_.inv_kf.push_back(1.0 / h.fluid_bulk_modulus);
+    model_.fluid = model_.fluid || m.hydraulic.has_value();
+    model_.plastic = model_.plastic || model_.constants.back().model != Model::linear_elastic;
   }
-  for (const Body& body : problem_.bodies)
-    state_variables_ =
-        std::max(state_variables_,
-                 state_variable_count(constants_[static_cast<std::size_t>(body.material)].model));
+  for (const Body& body : model_.problem.bodies)
+    model_.state_variables = std::max(
+        model_.state_variables,
+        state_variable_count(model_.constants[static_cast<std::size_t>(body.material)].model));
   for (const ProblemIssue& w : problem_warnings(job_))
     warnings_.push_back(w.where.text().append(": ").append(w.message));
-  for (int a = 0; a < Dim; ++a) gravity_[a] = problem_.gravity[a];
+  for (int a = 0; a < Dim; ++a) model_.gravity[a] = model_.problem.gravity[a];
 }
 
 template <int Dim, class Shape>
 void Simulation<Dim, Shape>::setup_particles() {
   const bool gimp = std::is_same_v<Shape, shape::Gimp>;
   interrupt_.stage("generating particles and evaluating their initial fields");
-  const std::vector<BodyLayout> layouts = body_layouts(problem_);
+  const std::vector<BodyLayout> layouts = body_layouts(model_.problem);
   std::int64_t count = 0;
   for (const BodyLayout& l : layouts) count += l.count;
-  particles_.resize(static_cast<std::size_t>(count), fluid_, gimp, state_variables_, plastic_);
-  grid_.resize(fluid_);
+  particles_.resize(static_cast<std::size_t>(count), model_.fluid, gimp, model_.state_variables,
+                    model_.plastic);
+  grid_.resize(model_.fluid);
   std::size_t p = 0;
   double cell_volume = 1.0;
   for (int a = 0; a < Dim; ++a) cell_volume *= grid_.h[a];
-  for (std::size_t b = 0; b < problem_.bodies.size(); ++b) {
-    const Body& body = problem_.bodies[b];
+  for (std::size_t b = 0; b < model_.problem.bodies.size(); ++b) {
+    const Body& body = model_.problem.bodies[b];
     const BodyLayout& layout = layouts[b];
-    const MaterialConstants& mc = constants_[static_cast<std::size_t>(body.material)];
+    const MaterialConstants& mc = model_.constants[static_cast<std::size_t>(body.material)];
     const int ppc = body.particles_per_cell;
     for (std::size_t k = 0; k < layout.positions.size(); ++k) {
       interrupt_.poll(p);
@@ -113,7 +117,7 @@ void Simulation<Dim, Shape>::setup_particles() {
         if (init.velocity[a]) particles_.v[p][a] = init.velocity[a](x3);
       for (int c = 0; c < 6; ++c)
         if (init.effective_stress[c]) particles_.stress[p][c] = init.effective_stress[c](x3);
-      if (fluid_ && mc.saturated) {
+      if (model_.fluid && mc.saturated) {
         const double p0 = init.pore_pressure ? init.pore_pressure(x3) : 0.0;
         particles_.pressure[p] = p0;
         particles_.pressure_out[p] = p0;
@@ -133,14 +137,15 @@ void Simulation<Dim, Shape>::setup_stages() {
   if (!moves) return;
   interrupt_.stage("setting the stages' bodies aside");
   std::int64_t first = 0;
-  for (const BodyLayout& l : body_layouts(problem_, LayoutDetail::counts)) {
+  for (const BodyLayout& l : body_layouts(model_.problem, LayoutDetail::counts)) {
     body_begin_.push_back(first);
     first += l.count;
   }
   particles_.id.resize(particles_.size());
   for (std::size_t p = 0; p < particles_.size(); ++p)
     particles_.id[p] = static_cast<std::int64_t>(p);
-  dormant_.resize(0, fluid_, std::is_same_v<Shape, shape::Gimp>, state_variables_, plastic_);
+  dormant_.resize(0, model_.fluid, std::is_same_v<Shape, shape::Gimp>, model_.state_variables,
+                  model_.plastic);
   move_stage_particles(0);
 }
 
@@ -155,11 +160,11 @@ void Simulation<Dim, Shape>::setup_stages() {
 /// every node and the ground stays at rest.
 template <int Dim, class Shape>
 void Simulation<Dim, Shape>::setup_geostatic() {
-  if (!problem_.initial_state.geostatic) return;
+  if (!model_.problem.initial_state.geostatic) return;
   interrupt_.stage("computing the geostatic state");
   // Without the bodies a stage adds (their particles wait in dormant_).
-  const GeostaticState g =
-      geostatic_state(body_begin_.empty() ? problem_ : initial_ground(problem_), &interrupt_);
+  const GeostaticState g = geostatic_state(
+      body_begin_.empty() ? model_.problem : initial_ground(model_.problem), &interrupt_);
   if (g.vertical.size() != particles_.size())
     throw std::invalid_argument(
         "the geostatic state has " + std::to_string(g.vertical.size()) +
@@ -169,12 +174,12 @@ void Simulation<Dim, Shape>::setup_geostatic() {
         ": a body a stage adds overlaps the ground; make them meet without overlapping");
   for (std::size_t p = 0; p < particles_.size(); ++p) {
     geostatic_voigt(g, p, particles_.stress[p].data());
-    if (fluid_ && constants_[particles_.material[p]].saturated) {
+    if (model_.fluid && model_.constants[particles_.material[p]].saturated) {
       particles_.pressure[p] = g.pressure[p];
       particles_.pressure_out[p] = g.pressure[p];
     }
   }
-  if (fluid_) balance_initial_pressure_state();
+  if (model_.fluid) balance_initial_pressure_state();
 }
 
 /// Richardson iteration on the particle pressure state s until the nodal
@@ -188,6 +193,7 @@ void Simulation<Dim, Shape>::balance_initial_pressure_state() {
   double scale = 0.0;
   for (double v : particles_.pressure_out) scale = std::max(scale, std::abs(v));
   if (scale == 0.0) return;
+  StepContext<Dim, Shape> ctx = context();
   StencilT s;
   double checkpoint = std::numeric_limits<double>::infinity();
   interrupt_.stage("balancing the initial pore pressure");
@@ -198,20 +204,21 @@ void Simulation<Dim, Shape>::balance_initial_pressure_state() {
     for (std::size_t p = 0; p < particles_.size(); ++p) {
       interrupt_.poll(p);
       const std::uint16_t mat = particles_.material[p];
-      if (!constants_[mat].saturated) continue;
-      stencil_of<false>(p, s);
+      if (!model_.constants[mat].saturated) continue;
+      ctx.template stencil_of<false>(p, s);
       const double n = particles_.porosity[p];
-      const double qv = ((1.0 - n) * inv_ks_[mat] + n * inv_kf_[mat]) * particles_.volume[p];
+      const double qv =
+          ((1.0 - n) * model_.inv_ks[mat] + n * model_.inv_kf[mat]) * particles_.volume[p];
       for (int k = 0; k < StencilT::N; ++k) {
         grid_.storage[s.node[k]] += s.w[k] * qv;
         grid_.pressure[s.node[k]] += s.w[k] * qv * particles_.pressure[p];
       }
     }
-    compute_nodal_pressure(0.0);
+    compute_nodal_pressure(ctx, 0.0);
     double residual = 0.0;
     for (std::size_t p = 0; p < particles_.size(); ++p) {
-      if (!constants_[particles_.material[p]].saturated) continue;
-      stencil_of<false>(p, s);
+      if (!model_.constants[particles_.material[p]].saturated) continue;
+      ctx.template stencil_of<false>(p, s);
       double p_hat = 0.0;
       for (int k = 0; k < StencilT::N; ++k) p_hat += s.w[k] * grid_.pressure[s.node[k]];
       const double r = particles_.pressure_out[p] - p_hat;

@@ -21,13 +21,22 @@
 // equations themselves are not: darcy_inertia_growth_ratio in
 // materials/material.hpp).
 //
+// The parts (ExaMPM's pattern): the state a step changes (GridState,
+// ParticleState), the Model it reads (the Problem in force, material
+// constants, compiled boundaries and loads), the Threads with their private
+// nodal sums (state/threads.hpp), the Failures (failures.hpp) and the
+// reaction tally. A scheme is given a StepContext, references to these
+// parts, and composes the phases, free functions over a StepContext, into a
+// step; nothing is a friend of the Simulation, which keeps only set-up, the
+// stages and the time loop.
+//
 // Where the code lives: set-up in setup.hpp, the phases in phases/ (one file
 // each: particle_to_grid, grid, grid_to_particle, stress_and_flux,
-// pore_pressure), failure reports in failures.hpp, output in output.hpp,
-// the time loop in time_loop.hpp. Explicitly instantiated per dimension in
-// simulation_instance.cpp, so every hot loop is compiled for fixed sizes
-// and inlined within one translation unit. No phase allocates, calls a
-// virtual function or looks anything up by string.
+// pore_pressure, pressure_projection, reactions), failure reports in
+// failures.hpp, output in output.hpp, the time loop in time_loop.hpp. Explicitly instantiated per
+// dimension in simulation_instance.cpp, so every hot loop is compiled for fixed sizes and inlined
+// within one translation unit. No phase allocates, calls a virtual function or looks anything up by
+// string.
 #pragma once
 
 #include <Eigen/Core>
@@ -36,224 +45,132 @@
 #include <array>
 #include <cstdint>
 #include <memory>
-#include <mutex>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "boundary/constraints.hpp"
 #include "boundary/tractions.hpp"
+#include "failures.hpp"
 #include "hmpm/problem.hpp"
 #include "hmpm/run.hpp"
 #include "interrupt.hpp"
 #include "materials/material.hpp"
-#include "parallel.hpp"
 #include "shape.hpp"
 #include "state/grid.hpp"
 #include "state/particles.hpp"
+#include "state/threads.hpp"
 
 namespace hmpm {
 
-template <int Dim, class Shape>
-class ExplicitScheme;
-template <int Dim, class Shape>
-class SemiImplicitScheme;
-template <int Dim, class Shape>
-class QuasiStaticScheme;
+/// What a step reads and does not change: the Problem in force (a stage's),
+/// the material constants, the compiled boundaries and loads. Set up by the
+/// Simulation, compiled again when a stage begins.
+template <int Dim>
+struct RunModel {
+  using Vec = VecD<Dim>;
+  Problem problem;  ///< the Problem in force: stage_problem(job, stage) (stages.hpp)
+  std::vector<MaterialConstants> constants;
+  std::vector<double> inv_ks, inv_kf;
+  /// Compiled boundaries; their per-step flags (a friction node sticking, an
+  /// absorbing base's forces at rest) change during a step.
+  mutable Constraints constraints;
+  std::vector<TractionLoad> tractions;
+  std::vector<FluxLoad> fluxes;  ///< saturated runs only
+  Vec gravity = Vec::Zero();
+  Vec grid_max = Vec::Zero();
+  bool fluid = false;
+  bool plastic = false;     ///< any material with a return mapping
+  int state_variables = 0;  ///< internal state variables per particle (materials/)
+  double mass_tolerance = 0.0;
+  StableStep stable;
+};
 
+/// A node component whose constraint force is charged to a boundary.
+struct ReactionCharge {
+  std::int64_t node;
+  int axis;
+  int boundary;     ///< index in Problem::boundaries
+  bool prescribed;  ///< a prescribed velocity (else friction or a rigid tie)
+  /// Friction: the wall's flag of the node sticking this step (null otherwise).
+  const std::uint8_t* stuck;
+};
+
+/// Reactions (set up only when the output asks for them; phases/reactions.hpp):
+/// per node component the boundary charged with it (-1: none), the charged
+/// components, a force kept per charge, the step's force of each boundary,
+/// and whether the time loop samples the current step.
+struct ReactionTally {
+  std::vector<int> owner;
+  std::vector<ReactionCharge> charges;
+  std::vector<double> extra;
+  std::vector<Vec3> force;
+  bool due = false;
+};
+
+/// What a time scheme is given: references to the parts of the run it may
+/// touch, and the stencil of a particle. Cheap to copy; each scheme keeps
+/// one, whose `damping` is the local damping of its current step.
 template <int Dim, class Shape>
-class Simulation {
- public:
+struct StepContext {
   using Vec = VecD<Dim>;
   using Mat = Eigen::Matrix<double, Dim, Dim>;
   using StencilT = shape::Stencil<Dim, Shape>;
   using Out = Scatter<Dim>;
+  /// The factors axes_ahead keeps: those of the particle and of the two after it.
+  using AxesAhead = typename StencilT::Axes[4];
 
-  /// Sets the run up; honours options.cancel and options.wall_time_limit_s
-  /// while doing so (throws SetupInterrupted, see interrupt.hpp).
-  Simulation(const Problem& problem, const RunOptions& options);
+  GridState<Dim>& grid;
+  ParticleState<Dim>& particles;
+  const RunModel<Dim>& model;
+  Threads<Dim, Shape>& threads;
+  Failures& failures;
+  ReactionTally& reactions;
+  double damping = 0.0;  ///< local damping coefficient of the current step
 
-  /// Runs the time loop to problem.time.end (time_loop.hpp).
-  RunResult run(const RunOptions& options);
-
- private:
-  friend class ExplicitScheme<Dim, Shape>;
-  friend class SemiImplicitScheme<Dim, Shape>;
-  friend class QuasiStaticScheme<Dim, Shape>;
-
-  // ------------------------------------------------------------ set-up (setup.hpp)
-  void setup_grid();
-  void setup_materials();
-  void setup_particles();
-  void setup_geostatic();
-  /// Staged jobs: the particles of bodies a stage adds leave the run until
-  /// then (set-up, before the geostatic state).
-  void setup_stages();
-
-  // ------------------------------------------------------------ stages (stages.hpp)
-  /// Makes stage k the one in force: its Problem, its bodies' particles,
-  /// the constraints, loads and reactions compiled for them.
-  void enter_stage(std::size_t k);
-  /// The particles of the bodies in force at stage k, and slot_ to match.
-  void move_stage_particles(std::size_t k);
-  /// Stage::reset_displacement: x0 = x, strain zero.
-  void reset_displacement();
-  void balance_initial_pressure_state();
-
-  // ------------------------------------------------------------ phases (phases/)
-  void clear_grid();
-  void map_particles_to_grid(const Out& out, std::size_t begin, std::size_t end);
-  void map_particles_to_grid_by_rows(const Out& out, std::size_t begin, std::size_t end);
-  void compute_nodal_pressure(double t);
-  void map_pore_pressure_force(const Out& out, std::size_t begin, std::size_t end);
-  void apply_surface_loads(double t);
-  /// Water across particle faces at time t (Problem::fluxes) added to the
-  /// nodal flux; nothing without fluxes.
-  void apply_boundary_fluxes(double t);
-  void update_nodal_momentum(double t, double dt);
-  void update_particle_velocities_and_remap(const Out& out, std::size_t begin, std::size_t end,
-                                            double dt);
-  void compute_remapped_nodal_velocity(double t_new, double dt);
-  template <bool Fluid, bool Plastic, bool ScatterFlux = true>
-  void update_particle_stress_and_fluid_flux(const Out& out, std::size_t begin, std::size_t end,
-                                             double dt);
-  void update_nodal_pressure(double t_new, double dt);
-  void update_particle_pressure_and_position(std::size_t begin, std::size_t end, double dt);
-  /// Moves particle p: x += dt v, v = sum N_i v_i (the Lagrangian nodal
-  /// velocity) gathered by the caller.
-  __attribute__((always_inline)) inline void displace_particle(std::size_t p, Vec v, double dt);
-  /// A particle outside the grid: back onto the face if a wall holds it there.
-  bool return_to_wall(std::size_t p);
-  static Mat active_stress(const Voigt& s);
-
-  // ------------------------------------------------------------ pressure projection
-  // The semi-implicit scheme's phases (phases/pressure_projection.hpp).
-  void map_predicted_velocity(const Out& out, std::size_t begin, std::size_t end, double dt);
-  void map_predicted_fluid_flux(const Out& out, std::size_t begin, std::size_t end);
-  void assemble_pressure_laplacian(std::size_t begin, std::size_t end, double dt, double* box,
-                                   std::uint8_t* active, std::int64_t first);
-  void map_pressure_increment_force(const Out& out, std::size_t begin, std::size_t end);
-
-  // ------------------------------------------------------------ threads
-  // Thread 0 accumulates nodal sums straight into the grid; every other
-  // thread into a private buffer that is added to the grid after the phase,
-  // buffers in thread order, so sums are reproducible for a thread count.
-
-  Out scatter_of(int t) {
-    NodeRange* touched = &touched_[static_cast<std::size_t>(t)];
-    NodeRecord* records = records_[static_cast<std::size_t>(t)].data();
-    if (t == 0) return {grid_.pointers(), touched, records};
-    return {buffers_[static_cast<std::size_t>(t - 1)].pointers(), touched, records};
-  }
-
-  void setup_threads(int threads) {
-    pool_ = std::make_unique<ThreadPool>(threads);
-    buffers_.resize(static_cast<std::size_t>(threads - 1));
-    touched_.assign(static_cast<std::size_t>(threads), NodeRange{0, grid_.count - 1});
-    for (NodalSums<Dim>& b : buffers_) b.resize(static_cast<std::size_t>(grid_.count), fluid_);
-    records_.resize(static_cast<std::size_t>(threads));
-    if constexpr (StencilT::factorised)  // map_particles_to_grid_by_rows's scratch
-      for (auto& r : records_) r.assign(static_cast<std::size_t>(grid_.count), NodeRecord{});
-  }
-
-  /// Runs phase(scatter, begin, end) over particle chunks, then adds the
-  /// private buffers of the nodal sums in `fields` (a mask of nodal::bit) to
-  /// the grid, in thread order, over the nodes each thread touched only,
-  /// clearing them as it goes. Particles created in cell order give each
-  /// thread a band of the grid, so the reduction costs about one band per
-  /// extra thread, not a whole grid. Phases that scatter nothing
-  /// (fields == 0) give each particle's result regardless of the thread
-  /// that computes it: they take blocks dynamically, so a slower virtual CPU
-  /// does less of the work.
+  /// Runs phase(scatter, begin, end) over the particles (Threads::for_particles).
   template <class Phase>
   void for_particles(unsigned fields, Phase&& phase) {
-    auto chunk = [&](int t, std::size_t b, std::size_t e) { phase(scatter_of(t), b, e); };
-    if (!fields) {
-      pool_->for_blocks(particles_.size(), block_of(particles_.size(), particle_block), chunk);
-      return;
-    }
-    pool_->for_ranges(particles_.size(), chunk);
-    if (buffers_.empty()) return;
-    // Every node of the buffers' bands, split over the threads.
-    std::int64_t lo = grid_.count, hi = -1;
-    for (std::size_t t = 1; t < touched_.size(); ++t) {
-      lo = std::min(lo, touched_[t].lo);
-      hi = std::max(hi, touched_[t].hi);
-    }
-    if (hi < lo) return;
-    auto reduce = [&](int, std::size_t b, std::size_t e) {
-      for (std::size_t t = 1; t < touched_.size(); ++t) {
-        const auto first = std::max(b, static_cast<std::size_t>(touched_[t].lo));
-        const auto last = std::min(e, static_cast<std::size_t>(touched_[t].hi + 1));
-        if (first < last) grid_.add_and_clear(buffers_[t - 1], fields, first, last);
-      }
-    };
-    const auto offset = static_cast<std::size_t>(lo);
-    auto band = [&](int t, std::size_t b, std::size_t e) { reduce(t, offset + b, offset + e); };
-    const auto nodes = static_cast<std::size_t>(hi - lo + 1);
-    pool_->for_blocks(nodes, block_of(nodes, node_block), band);
+    threads.for_particles(grid, particles.size(), fields, phase);
   }
-
-  /// Runs f(begin, end) over blocks of the nodes [0, grid count), taken by
-  /// the threads dynamically (node loops whose iterations are independent:
-  /// no node loop sums across nodes, so the results do not depend on the
-  /// split).
+  /// Runs f(begin, end) over blocks of the nodes (Threads::for_nodes).
   template <class F>
   void for_nodes(F&& f) {
-    if (!pool_) {  // set-up, before run() starts the threads
-      f(std::int64_t{0}, grid_.count);
-      return;
-    }
-    auto chunk = [&](int, std::size_t b, std::size_t e) {
-      f(static_cast<std::int64_t>(b), static_cast<std::int64_t>(e));
-    };
-    const auto nodes = static_cast<std::size_t>(grid_.count);
-    pool_->for_blocks(nodes, block_of(nodes, node_block), chunk);
-  }
-
-  /// Block sizes of dynamically shared loops: at most a few hundred
-  /// microseconds of work, and at least 16 blocks per thread, so the faster
-  /// thread can take up the slack (small runs get small blocks).
-  static constexpr std::size_t particle_block = 4096, node_block = 8192;
-  std::size_t block_of(std::size_t n, std::size_t largest) const {
-    return std::clamp<std::size_t>(n / (16 * static_cast<std::size_t>(pool_->size())), 64, largest);
+    threads.for_nodes(grid.count, f);
   }
 
   /// The stencil of particle p at its current position.
   template <bool Grad = true>
   inline void stencil_of(std::size_t p, StencilT& s) const {
-    s.template compute<Grad>(particles_.x[p], grid_.origin, grid_.inv_h, grid_.cells, grid_.stride,
+    s.template compute<Grad>(particles.x[p], grid.origin, grid.inv_h, grid.cells, grid.stride,
                              box_of(p));
   }
 
   /// In the step: the first phase locates each particle's stencil (and
   /// records the cells), the later phases, before particles move, reuse them.
   template <bool Grad, bool Located>
-  __attribute__((always_inline)) inline void stencil_in_step(std::size_t p, StencilT& s) {
-    s.template compute<Grad, Located>(particles_.x[p], grid_.origin, grid_.inv_h, grid_.cells,
-                                      grid_.stride, box_of(p), particles_.cell[p].data());
+  __attribute__((always_inline)) inline void stencil_in_step(std::size_t p, StencilT& s) const {
+    s.template compute<Grad, Located>(particles.x[p], grid.origin, grid.inv_h, grid.cells,
+                                      grid.stride, box_of(p), particles.cell[p].data());
   }
 
   /// The factors of particle p's stencil (StencilT::factorised shape functions).
   template <bool Located, bool Grad = true>
   __attribute__((always_inline)) inline void axes_in_step(std::size_t p,
-                                                          typename StencilT::Axes& f) {
-    StencilT::template axes<Located, Grad>(particles_.x[p], grid_.origin, grid_.inv_h, grid_.cells,
-                                           grid_.stride, box_of(p), particles_.cell[p].data(), f);
+                                                          typename StencilT::Axes& f) const {
+    StencilT::template axes<Located, Grad>(particles.x[p], grid.origin, grid.inv_h, grid.cells,
+                                           grid.stride, box_of(p), particles.cell[p].data(), f);
   }
-
-  /// The factors axes_ahead keeps: those of the particle and of the two after it.
-  using AxesAhead = typename StencilT::Axes[4];
 
   /// In a loop over particles [begin, end), particle p's factors (computed
   /// two particles before) after computing particle p + 2's: the chain of
   /// dependent operations of a stencil's factors then overlaps the sums of
-  /// the particles before (software pipelining: one particle ahead bought
-  /// 4-9 % of a 2D step, two about 2-5 % more). Nothing computed for the
-  /// node-by-node shape functions (!StencilT::factorised); Grad = false:
-  /// weights only.
+  /// the particles before (software pipelining; docs/performance.md).
+  /// Nothing computed for the node-by-node shape functions
+  /// (!StencilT::factorised); Grad = false: weights only.
   template <bool Located, bool Grad = true>
   __attribute__((always_inline)) inline const typename StencilT::Axes& axes_ahead(
-      std::size_t p, std::size_t begin, std::size_t end, AxesAhead& ahead) {
+      std::size_t p, std::size_t begin, std::size_t end, AxesAhead& ahead) const {
     if constexpr (StencilT::factorised) {
       if (p == begin) {
         axes_in_step<Located, Grad>(p, ahead[0]);
@@ -267,42 +184,64 @@ class Simulation {
   /// Particle p's GIMP box (zero for the other shape functions).
   inline shape::Box box_of(std::size_t p) const {
     if constexpr (std::is_same_v<Shape, shape::Gimp>)  // the arrays are there
-      return {particles_.half_length[p], particles_.box_inverse[p]};
+      return {particles.half_length[p], particles.box_inverse[p]};
     else
-      return shape::box_of(particles_, p);
+      return shape::box_of(particles, p);
+  }
+};
+
+/// The stress tensor of Voigt components (xx, yy, zz, xy, yz, zx) in Dim
+/// dimensions.
+template <int Dim>
+inline Eigen::Matrix<double, Dim, Dim> active_stress(const Voigt& s) {
+  Eigen::Matrix<double, Dim, Dim> m;
+  if constexpr (Dim == 1) {
+    m(0, 0) = s[0];
+  } else if constexpr (Dim == 2) {
+    m << s[0], s[3], s[3], s[1];
+  } else {
+    m << s[0], s[3], s[5], s[3], s[1], s[4], s[5], s[4], s[2];
+  }
+  return m;
+}
+
+template <int Dim, class Shape>
+class Simulation {
+ public:
+  using Vec = VecD<Dim>;
+  using StencilT = shape::Stencil<Dim, Shape>;
+
+  /// Sets the run up; honours options.cancel and options.wall_time_limit_s
+  /// while doing so (throws SetupInterrupted, see interrupt.hpp).
+  Simulation(const Problem& problem, const RunOptions& options);
+
+  /// Runs the time loop to problem.time.end (time_loop.hpp).
+  RunResult run(const RunOptions& options);
+
+ private:
+  /// The parts a scheme is given.
+  StepContext<Dim, Shape> context() {
+    return {grid_, particles_, model_, threads_, failures_, reactions_};
   }
 
-  // ------------------------------------------------------------ failures (failures.hpp)
-  // Called from hot loops only on the failure path. Threads may find
-  // failures in any order; the lowest particle index wins, so the report is
-  // the same for any thread count.
-  void record_failure(std::size_t p, std::string what, std::string hint);
-  void fail_run(std::string what, std::string hint);
-  void fail_nonfinite(std::size_t p, const char* what);
-  void fail_left_grid(std::size_t p);
-  void fail_volume(std::size_t p, double j);
-  /// False (and a failure of the run naming the formula's place in the
-  /// spec) when a traction or boundary value is not finite at time t.
-  bool loads_finite_at(double t);
-  static std::string number(double v);
+  // ------------------------------------------------------------ set-up (setup.hpp)
+  void setup_grid();
+  void setup_materials();
+  void setup_particles();
+  void setup_geostatic();
+  /// Staged jobs: the particles of bodies a stage adds leave the run until
+  /// then (set-up, before the geostatic state).
+  void setup_stages();
+  void balance_initial_pressure_state();
 
-  // ------------------------------------------------------------ reactions (phases/reactions.hpp)
-  /// A node component whose constraint force is charged to a boundary.
-  struct ReactionCharge {
-    std::int64_t node;
-    int axis;
-    int boundary;     ///< index in Problem::boundaries
-    bool prescribed;  ///< a prescribed velocity (else friction or a rigid tie)
-    /// Friction: the wall's flag of the node sticking this step (null otherwise).
-    const std::uint8_t* stuck;
-  };
-  void setup_reactions();
-  /// Keeps `force` at the charged components (the semi-implicit step's
-  /// pressure-increment force, gone from the grid by the time of the tally).
-  void record_reaction_extra_force(const std::vector<Vec>& force);
-  /// reaction_ from the constrained nodal accelerations of this step; with
-  /// the forces record_reaction_extra_force kept, when `with_extra`.
-  void tally_reactions(bool with_extra);
+  // ------------------------------------------------------------ stages (stages.hpp)
+  /// Makes stage k the one in force: its Problem, its bodies' particles,
+  /// the constraints, loads and reactions compiled for them.
+  void enter_stage(std::size_t k);
+  /// The particles of the bodies in force at stage k, and slot_ to match.
+  void move_stage_particles(std::size_t k);
+  /// Stage::reset_displacement: x0 = x, strain zero.
+  void reset_displacement();
 
   // ------------------------------------------------------------ output (output.hpp)
   void fill_snapshot(Snapshot& snap, const std::vector<Field>& fields) const;
@@ -314,8 +253,6 @@ class Simulation {
                             double t) const;
 
   const Problem& job_;  ///< the job as given, every stage (Problem::stages)
-  /// The Problem in force: stage_problem(job_, stage_) (stages.hpp).
-  Problem problem_;
   std::size_t stage_ = 0;
   // Stages that add or remove bodies: the particles of bodies not in the
   // run (yet, or any more), each particle's slot by its job index (-1: not
@@ -323,44 +260,17 @@ class Simulation {
   ParticleState<Dim> dormant_;
   std::vector<std::int64_t> slot_;
   std::vector<std::int64_t> body_begin_;
-  std::int64_t job_particles_ = 0;  ///< particles of every body of the job
-  SetupInterrupt interrupt_;        ///< set-up's stop checks; its start is the run's start
+  std::int64_t job_particles_ = 0;     ///< particles of every body of the job
+  SetupInterrupt interrupt_;           ///< set-up's stop checks; its start is the run's start
+  std::vector<std::string> warnings_;  ///< set-up findings the result reports
+
+  // The parts (StepContext).
   GridState<Dim> grid_;
   ParticleState<Dim> particles_;
-  std::vector<MaterialConstants> constants_;
-  std::vector<double> inv_ks_, inv_kf_;
-  Constraints constraints_;
-  std::vector<TractionLoad> tractions_;
-  std::vector<FluxLoad> fluxes_;  ///< saturated runs only
-  // Reactions (set up only when the output asks for them): per node
-  // component the boundary charged with it (-1: none), the charged
-  // components, a force kept per charge, the step's force of each boundary,
-  // and whether the time loop samples the current step.
-  std::vector<int> reaction_owner_;
-  std::vector<ReactionCharge> charges_;
-  std::vector<double> charge_extra_;
-  std::vector<Vec3> reaction_;
-  bool reactions_due_ = false;
-  Vec gravity_ = Vec::Zero();
-  Vec grid_max_ = Vec::Zero();
-  bool fluid_ = false;
-  bool plastic_ = false;               ///< any material with a return mapping
-  int state_variables_ = 0;            ///< internal state variables per particle (materials/)
-  std::vector<std::string> warnings_;  ///< set-up findings the result reports
-  double mass_tolerance_ = 0.0;
-  StableStep stable_;
-
-  std::unique_ptr<ThreadPool> pool_;
-  std::vector<NodalSums<Dim>> buffers_;           ///< threads 1.. : private nodal sums
-  std::vector<NodeRange> touched_;                ///< per thread, from the step's first phase
-  std::vector<std::vector<NodeRecord>> records_;  ///< per thread: particle-to-grid scratch
-
-  std::mutex failure_mutex_;
-  double damping_ = 0.0;  // local damping coefficient of the current step
-  bool failed_ = false;   // written under failure_mutex_, read between phases
-  std::int64_t failure_particle_ = -1;
-  std::string failure_;
-  std::string failure_hint_;
+  RunModel<Dim> model_;
+  Threads<Dim, Shape> threads_;
+  Failures failures_;
+  ReactionTally reactions_;
 };
 
 }  // namespace hmpm

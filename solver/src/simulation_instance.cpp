@@ -30,6 +30,7 @@ RunResult run_checked(const Problem& problem, const RunOptions& options) {
     result.status = stop.status;
     result.message = stop.message;
     result.scheme = scheme_name(problem.time.scheme);
+    result.reports_iterations = scheme_row(problem.time.scheme).reports_iterations;
     return result;
   }
 }

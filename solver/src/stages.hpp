@@ -53,21 +53,24 @@ void Simulation<Dim, Shape>::enter_stage(std::size_t k) {
   // step's mean rates, dx / dt) to an inertial one, the ground starts at
   // rest: a gravity-loading stage of one long step would otherwise hand its
   // whole settlement over as a velocity.
-  const bool was_static = problem_.time.scheme == Scheme::quasi_static;
+  const bool was_static = model_.problem.time.scheme == Scheme::quasi_static;
   stage_ = k;
-  problem_ = stage_problem(job_, k);
-  if (was_static && problem_.time.scheme != Scheme::quasi_static)
+  model_.problem = stage_problem(job_, k);
+  if (was_static && model_.problem.time.scheme != Scheme::quasi_static)
     for (auto& v : particles_.v) v.setZero();
-  for (int a = 0; a < Dim; ++a) gravity_[a] = problem_.gravity[a];
+  for (int a = 0; a < Dim; ++a) model_.gravity[a] = model_.problem.gravity[a];
   // The loads are laid on the particles' initial faces: their initial
   // volumes, from the constant mass and the material's mixture density.
   std::vector<double> volume0(particles_.size());
   for (std::size_t p = 0; p < particles_.size(); ++p)
-    volume0[p] = particles_.mass[p] / constants_[particles_.material[p]].mixture_density;
-  constraints_ = compile_constraints<Dim>(problem_, grid_, grid_max_, fluid_, particles_);
-  tractions_ = compile_tractions<Dim>(problem_, particles_, volume0, grid_);
-  if (fluid_) fluxes_ = compile_fluxes<Dim>(problem_, particles_, volume0, grid_);
-  if (problem_.output.reactions_interval > 0) setup_reactions();
+    volume0[p] = particles_.mass[p] / model_.constants[particles_.material[p]].mixture_density;
+  model_.constraints =
+      compile_constraints<Dim>(model_.problem, grid_, model_.grid_max, model_.fluid, particles_);
+  model_.tractions = compile_tractions<Dim>(model_.problem, particles_, volume0, grid_);
+  if (model_.fluid) model_.fluxes = compile_fluxes<Dim>(model_.problem, particles_, volume0, grid_);
+  if (model_.problem.output.reactions_interval > 0)
+    setup_reactions<Dim>(reactions_, model_.constraints, grid_.count,
+                         model_.problem.boundaries.size());
 }
 
 }  // namespace hmpm

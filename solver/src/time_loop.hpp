@@ -21,27 +21,12 @@
 #include "checkpoint.hpp"
 #include "output.hpp"
 #include "run_watch.hpp"
-#include "schemes/explicit_scheme.hpp"
-#include "schemes/quasi_static_scheme.hpp"
-#include "schemes/semi_implicit_scheme.hpp"
+#include "schemes/make_scheme.hpp"
+#include "schemes/table.hpp"
 #include "schemes/time_scheme.hpp"
 #include "simulation.hpp"
 
 namespace hmpm {
-
-/// The scheme problem.time.scheme names, over this simulation.
-template <int Dim, class Shape>
-std::unique_ptr<TimeScheme> make_scheme(Simulation<Dim, Shape>& sim, const Problem& problem) {
-  switch (problem.time.scheme) {
-    case Scheme::semi_implicit:
-      return std::make_unique<SemiImplicitScheme<Dim, Shape>>(sim);
-    case Scheme::quasi_static:
-      return std::make_unique<QuasiStaticScheme<Dim, Shape>>(sim);
-    case Scheme::explicit_scheme:
-      break;
-  }
-  return std::make_unique<ExplicitScheme<Dim, Shape>>(sim);
-}
 
 /// Adds a stage's iteration counts to the job's (the worst step overall
 /// keeps its residual history).
@@ -70,10 +55,11 @@ RunResult Simulation<Dim, Shape>::run(const RunOptions& options) {
   }
   const double end = stage_problem(job_, stages - 1).time.end;  // the job's end
   result.scheme = scheme_name(job_.time.scheme);
+  result.reports_iterations = scheme_row(job_.time.scheme).reports_iterations;
   double min_mass = std::numeric_limits<double>::infinity();
   for (double m : particles_.mass) min_mass = std::min(min_mass, m);
   for (double m : dormant_.mass) min_mass = std::min(min_mass, m);
-  mass_tolerance_ = job_particles_ > 0 ? 1e-12 * min_mass : 0.0;
+  model_.mass_tolerance = job_particles_ > 0 ? 1e-12 * min_mass : 0.0;
   // Threads: every core when asked for <= 0, but at least
   // min_particles_per_thread particles each.
   int threads = options.threads > 0
@@ -81,15 +67,16 @@ RunResult Simulation<Dim, Shape>::run(const RunOptions& options) {
                     : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   threads = static_cast<int>(std::clamp<std::int64_t>(
       job_particles_ / std::max<std::int64_t>(1, options.min_particles_per_thread), 1, threads));
-  setup_threads(threads);
+  threads_.start(threads, grid_, model_.fluid);
 
   result.particles = job_particles_;
   result.nodes = grid_.count;
   result.state_bytes = particles_.bytes() + dormant_.bytes() + grid_.bytes() * threads;
-  for (const auto& r : records_)
+  for (const auto& r : threads_.records)
     result.state_bytes += static_cast<std::int64_t>(r.size() * sizeof(NodeRecord));
   result.threads = threads;
   result.warnings = warnings_;
+  failures_.warned = !warnings_.empty();
 
   // Output set-up.
   const OutputRequest& out = job_.output;
@@ -229,11 +216,11 @@ RunResult Simulation<Dim, Shape>::run(const RunOptions& options) {
     particles_.for_each_array(
         [&](auto& a) { r.array(a, static_cast<std::int64_t>(a.size()), "particle array"); });
     const auto absorbing = r.pod<std::uint64_t>();
-    if (absorbing != constraints_.absorbing.size())
+    if (absorbing != model_.constraints.absorbing.size())
       throw std::invalid_argument("the checkpoint has " + std::to_string(absorbing) +
                                   " absorbing boundaries where this run has " +
-                                  std::to_string(constraints_.absorbing.size()));
-    for (AbsorbingConstraint& ab : constraints_.absorbing) {
+                                  std::to_string(model_.constraints.absorbing.size()));
+    for (AbsorbingConstraint& ab : model_.constraints.absorbing) {
       ab.held = r.pod<std::uint8_t>() != 0;
       r.array(ab.hold, static_cast<std::int64_t>(ab.hold.size()), "absorbing boundary's forces");
       r.array(ab.coefficient, static_cast<std::int64_t>(ab.coefficient.size()),
@@ -300,8 +287,8 @@ RunResult Simulation<Dim, Shape>::run(const RunOptions& options) {
     w.pod(done_iterations.max_nonlinear);
     w.array(done_iterations.worst_residuals);
     particles_.for_each_array([&](const auto& a) { w.array(a); });
-    w.pod(static_cast<std::uint64_t>(constraints_.absorbing.size()));
-    for (const AbsorbingConstraint& ab : constraints_.absorbing) {
+    w.pod(static_cast<std::uint64_t>(model_.constraints.absorbing.size()));
+    for (const AbsorbingConstraint& ab : model_.constraints.absorbing) {
       w.pod(static_cast<std::uint8_t>(ab.held ? 1 : 0));
       w.array(ab.hold);
       w.array(ab.coefficient);  // from the particles where the stage began
@@ -332,9 +319,10 @@ RunResult Simulation<Dim, Shape>::run(const RunOptions& options) {
   result.status = RunStatus::successful;
   for (std::size_t k = first_stage; k < stages && result.status == RunStatus::successful; ++k) {
     if (k != stage_) enter_stage(k);
-    const std::unique_ptr<TimeScheme> scheme = make_scheme(*this, problem_);
+    const std::unique_ptr<TimeScheme> scheme = make_scheme(context(), model_.problem.time.scheme);
     TimeScheme& time_scheme = *scheme;  // the loop sees the interface only
-    stable_ = time_scheme.stable_step(problem_);
+    model_.stable = time_scheme.stable_step(model_.problem);
+    failures_.stable_limit = model_.stable.limit;
     if (resume) {
       time_scheme.load(*resume);
       if (resume->position() != checkpoint::body_end(*options.resume))
@@ -347,15 +335,15 @@ RunResult Simulation<Dim, Shape>::run(const RunOptions& options) {
     // Fixed steps: step j of the stage ends at start + (j + 1) dt, the last
     // at the stage's end exactly. Varying steps (quasi_static growth): the
     // scheme says each length.
-    const bool fixed = stable_.fixed;
-    const double dt = stable_.chosen;
-    const double t0 = problem_.time.start, stage_end = problem_.time.end;
-    const std::int64_t steps = std::max<std::int64_t>(1, stable_.steps);
+    const bool fixed = model_.stable.fixed;
+    const double dt = model_.stable.chosen;
+    const double t0 = model_.problem.time.start, stage_end = model_.problem.time.end;
+    const std::int64_t steps = std::max<std::int64_t>(1, model_.stable.steps);
     const double eps_t = 1e-9 * dt;
     std::int64_t j = fixed ? std::llround((t - t0) / dt) : 0;  // steps done in this stage
 
     // Plausibility of the state (run_watch.hpp): about 500 checks per stage.
-    RunWatch<Dim> watch(problem_, constants_);
+    RunWatch<Dim> watch(model_.problem, model_.constants);
     const std::int64_t watch_stride = std::max<std::int64_t>(1, steps / 500);
     std::int64_t watched = -1;  // the step count at the last check
 
@@ -383,21 +371,23 @@ RunResult Simulation<Dim, Shape>::run(const RunOptions& options) {
       // the step uses them (the start's was checked by the step before, or
       // below at a stage's start): a NaN there is reported as the formula's,
       // not as the divergence it would cause.
-      reactions_due_ = want_reactions && t_new >= next_reaction - eps_t;
-      if ((j > 0 || loads_finite_at(t)) && loads_finite_at(t_new)) time_scheme.step(t, t_new - t);
-      if (failed_) {
+      reactions_.due = want_reactions && t_new >= next_reaction - eps_t;
+      if ((j > 0 || loads_finite_at<Dim>(model_.problem, model_.fluid, failures_, t)) &&
+          loads_finite_at<Dim>(model_.problem, model_.fluid, failures_, t_new))
+        time_scheme.step(t, t_new - t);
+      if (failures_.failed) {
         std::ostringstream where;
-        if (failure_particle_ >= 0) {  // -1: a failure of the run, not of a particle
-          const auto p = static_cast<std::size_t>(failure_particle_);
-          where << ", particle " << (particles_.id.empty() ? failure_particle_ : particles_.id[p])
+        if (failures_.particle >= 0) {  // -1: a failure of the run, not of a particle
+          const auto p = static_cast<std::size_t>(failures_.particle);
+          where << ", particle " << (particles_.id.empty() ? failures_.particle : particles_.id[p])
                 << " at (";
           for (int a = 0; a < Dim; ++a) where << (a ? ", " : "") << number(particles_.x[p][a]);
           where << ")";
         }
         result.status = RunStatus::failed;
         result.message = stage_text() + "step " + std::to_string(n + 1) + " (t = " + number(t_new) +
-                         " s)" + where.str() + ": " + failure_ +
-                         ". What to change: " + failure_hint_ + ".";
+                         " s)" + where.str() + ": " + failures_.what +
+                         ". What to change: " + failures_.hint + ".";
         t = t_new;
         ++n;
         break;
@@ -412,11 +402,12 @@ RunResult Simulation<Dim, Shape>::run(const RunOptions& options) {
         if (out.series_interval > 0)
           while (next_series <= t + eps_t) next_series += out.series_interval;
       }
-      if (reactions_due_) {
+      if (reactions_.due) {
         reactions.time.push_back(t);
         for (std::size_t b = 0; b < reactions.force.size(); ++b)
           for (int a = 0; a < Dim; ++a)
-            reactions.force[b].push_back(b < reaction_.size() ? reaction_[b][a] : 0.0);
+            reactions.force[b].push_back(b < reactions_.force.size() ? reactions_.force[b][a]
+                                                                     : 0.0);
         while (next_reaction <= t + eps_t) next_reaction += out.reactions_interval;
       }
       if (want_profiles && t >= next_profile - eps_t) {

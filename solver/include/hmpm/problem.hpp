@@ -341,18 +341,9 @@ struct TimeControl {
   ImplicitControl implicit;
 };
 
-/// The contract name of a scheme ("explicit", "semi_implicit", "quasi_static").
-inline const char* scheme_name(Scheme s) {
-  switch (s) {
-    case Scheme::semi_implicit:
-      return "semi_implicit";
-    case Scheme::quasi_static:
-      return "quasi_static";
-    case Scheme::explicit_scheme:
-      break;
-  }
-  return "explicit";
-}
+/// The contract name of a scheme ("explicit", "semi_implicit", "quasi_static"):
+/// its row in the solver's table of schemes (src/schemes/table.hpp).
+const char* scheme_name(Scheme s);
 
 /// A profile: fields of the particles nearest to points along a line (the
 /// api picks them: output.profiles in the job spec), sampled together.

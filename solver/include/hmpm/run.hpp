@@ -287,6 +287,8 @@ struct RunResult {
   std::int64_t state_bytes = 0;     ///< particle + grid state in memory
   int threads = 1;                  ///< solver threads actually used
   std::string scheme = "explicit";  ///< scheme_name() of the run's scheme
+  /// The scheme reports iteration counts (`iterations`; the implicit schemes).
+  bool reports_iterations = false;
   /// Implicit schemes: their iteration counts (zero for the explicit one).
   struct Iterations {
     std::int64_t nonlinear = 0;  ///< Newton iterations, all steps (quasi_static)

@@ -14,10 +14,12 @@ namespace hmpm {
 /// Phase 3: FLIP update of particle velocities, v_p += dt sum N_i a_i, and
 /// re-mapping of the updated momentum (MUSL, Eq. 26).
 template <int Dim, class Shape>
-inline void Simulation<Dim, Shape>::update_particle_velocities_and_remap(const Out& out,
-                                                                         std::size_t begin,
-                                                                         std::size_t end,
-                                                                         double dt) {
+inline void update_particle_velocities_and_remap(StepContext<Dim, Shape>& ctx,
+                                                 const Scatter<Dim>& out, std::size_t begin,
+                                                 std::size_t end, double dt) {
+  using StencilT = shape::Stencil<Dim, Shape>;
+  using AxesAhead = typename StepContext<Dim, Shape>::AxesAhead;
+  using Vec = VecD<Dim>;
   StencilT s;
   // A local copy: the compiler otherwise reloads the pointer at every node
   // (Eigen's vector stores may alias it).
@@ -26,14 +28,14 @@ inline void Simulation<Dim, Shape>::update_particle_velocities_and_remap(const O
   // The same for the arrays read and written per particle (the stores to
   // remap_out may alias them for the compiler, which then reloads the
   // particle's velocity it has just stored).
-  const Vec* const accel = grid_.accel.data();
-  const double* const mass = particles_.mass.data();
-  Vec* const velocity = particles_.v.data();
+  const Vec* const accel = ctx.grid.accel.data();
+  const double* const mass = ctx.particles.mass.data();
+  Vec* const velocity = ctx.particles.v.data();
   for (std::size_t p = begin; p < end; ++p) {
-    const auto& f = axes_ahead</*Located=*/true, /*Grad=*/false>(p, begin, end, ahead);
+    const auto& f = ctx.template axes_ahead</*Located=*/true, /*Grad=*/false>(p, begin, end, ahead);
     if constexpr (StencilT::factorised) {  // row by row (StencilT::Axes)
       Vec a = Vec::Zero();
-      f.for_rows(grid_.stride, [&](std::int64_t row, double wr, const auto&) {
+      f.for_rows(ctx.grid.stride, [&](std::int64_t row, double wr, const auto&) {
         f.add_scaled(a, wr, f.row_sum(f.w[0], accel + row));
       });
       const double m = mass[p];
@@ -42,17 +44,17 @@ inline void Simulation<Dim, Shape>::update_particle_velocities_and_remap(const O
       velocity[p] = v;
       Vec mv;
       for (int c = 0; c < Dim; ++c) mv[c] = m * v[c];
-      f.for_rows(grid_.stride, [&](std::int64_t row, double wr, const auto&) {
+      f.for_rows(ctx.grid.stride, [&](std::int64_t row, double wr, const auto&) {
         Vec rmv;
         for (int c = 0; c < Dim; ++c) rmv[c] = wr * mv[c];
         for (int i = 0; i < 3; ++i) f.add_scaled(remap_out[row + i], f.w[0][i], rmv);
       });
     } else {
-      stencil_in_step<false, true>(p, s);
+      ctx.template stencil_in_step<false, true>(p, s);
       Vec a = Vec::Zero();
-      for (int k = 0; k < StencilT::N; ++k) a += s.w[k] * grid_.accel[s.node[k]];
-      particles_.v[p] += dt * a;
-      const Vec mv = particles_.mass[p] * particles_.v[p];
+      for (int k = 0; k < StencilT::N; ++k) a += s.w[k] * ctx.grid.accel[s.node[k]];
+      ctx.particles.v[p] += dt * a;
+      const Vec mv = ctx.particles.mass[p] * ctx.particles.v[p];
       for (int k = 0; k < StencilT::N; ++k) remap_out[s.node[k]] += s.w[k] * mv;
     }
   }
@@ -64,21 +66,23 @@ inline void Simulation<Dim, Shape>::update_particle_velocities_and_remap(const O
 /// velocity, stress or force makes the nodal velocities, hence the
 /// position, non-finite in the same or the next step.
 template <int Dim, class Shape>
-__attribute__((always_inline)) inline void Simulation<Dim, Shape>::displace_particle(std::size_t p,
-                                                                                     Vec v,
-                                                                                     double dt) {
+__attribute__((always_inline)) inline void displace_particle(StepContext<Dim, Shape>& ctx,
+                                                             std::size_t p, VecD<Dim> v,
+                                                             double dt) {
+  using Vec = VecD<Dim>;
   const Vec dx = v * dt;
-  Vec& x = particles_.x[p];
+  Vec& x = ctx.particles.x[p];
   x += dx;
   // Branch-free: one test per axis, which a NaN position also fails.
   int inside = 1;
   for (int a = 0; a < Dim; ++a)
-    inside &= static_cast<int>(x[a] >= grid_.origin[a]) & static_cast<int>(x[a] <= grid_max_[a]);
+    inside &= static_cast<int>(x[a] >= ctx.grid.origin[a]) &
+              static_cast<int>(x[a] <= ctx.model.grid_max[a]);
   if (!inside) [[unlikely]] {
-    if (!x.allFinite() || !particles_.v[p].allFinite())
-      fail_nonfinite(p, "velocity");
-    else if (!return_to_wall(p))
-      fail_left_grid(p);
+    if (!x.allFinite() || !ctx.particles.v[p].allFinite())
+      ctx.failures.nonfinite(p, "velocity");
+    else if (!return_to_wall(ctx, p))
+      ctx.failures.left_grid(p);
   }
 }
 
@@ -92,25 +96,26 @@ __attribute__((always_inline)) inline void Simulation<Dim, Shape>::displace_part
 /// creeps through it). False, and nothing changed, when the particle left
 /// through a face with no wall, or one whose velocity carries it out.
 template <int Dim, class Shape>
-__attribute__((noinline)) bool Simulation<Dim, Shape>::return_to_wall(std::size_t p) {
-  Vec x = particles_.x[p];
+__attribute__((noinline)) bool return_to_wall(StepContext<Dim, Shape>& ctx, std::size_t p) {
+  using Vec = VecD<Dim>;
+  Vec x = ctx.particles.x[p];
   std::int64_t node = 0;
   for (int a = 0; a < Dim; ++a) {
-    const double xi = std::clamp((x[a] - grid_.origin[a]) * grid_.inv_h[a], 0.0,
-                                 static_cast<double>(grid_.cells[a]));
-    node += std::lround(xi) * grid_.stride[a];
+    const double xi = std::clamp((x[a] - ctx.grid.origin[a]) * ctx.grid.inv_h[a], 0.0,
+                                 static_cast<double>(ctx.grid.cells[a]));
+    node += std::lround(xi) * ctx.grid.stride[a];
   }
   const auto i = static_cast<std::size_t>(node);
   for (int a = 0; a < Dim; ++a) {
-    const bool below = x[a] < grid_.origin[a];
-    const bool above = x[a] > grid_max_[a];
+    const bool below = x[a] < ctx.grid.origin[a];
+    const bool above = x[a] > ctx.model.grid_max[a];
     if (!below && !above) continue;
-    if (!(constraints_.prescribed_axes[i] & (1u << a))) return false;
-    const double v = grid_.velocity[i][a];
+    if (!(ctx.model.constraints.prescribed_axes[i] & (1u << a))) return false;
+    const double v = ctx.grid.velocity[i][a];
     if (below ? v < 0.0 : v > 0.0) return false;
-    x[a] = below ? grid_.origin[a] : grid_max_[a];
+    x[a] = below ? ctx.grid.origin[a] : ctx.model.grid_max[a];
   }
-  particles_.x[p] = x;
+  ctx.particles.x[p] = x;
   return true;
 }
 

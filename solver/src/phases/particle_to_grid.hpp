@@ -12,23 +12,8 @@ namespace hmpm {
 
 /// Zeroes every nodal sum (the one list of state/grid.hpp).
 template <int Dim, class Shape>
-inline void Simulation<Dim, Shape>::clear_grid() {
-  for_nodes([&](std::int64_t b, std::int64_t e) { grid_.clear(b, e); });
-}
-
-/// Total stress divergence term of one particle: f_i -= V sigma grad N_i,
-/// with sigma the (3D) effective stress restricted to the active axes.
-template <int Dim, class Shape>
-inline typename Simulation<Dim, Shape>::Mat Simulation<Dim, Shape>::active_stress(const Voigt& s) {
-  Mat m;
-  if constexpr (Dim == 1) {
-    m(0, 0) = s[0];
-  } else if constexpr (Dim == 2) {
-    m << s[0], s[3], s[3], s[1];
-  } else {
-    m << s[0], s[3], s[5], s[3], s[1], s[4], s[5], s[4], s[2];
-  }
-  return m;
+inline void clear_grid(StepContext<Dim, Shape>& ctx) {
+  ctx.for_nodes([&](std::int64_t b, std::int64_t e) { ctx.grid.clear(b, e); });
 }
 
 /// Phase 1: mass, momentum and effective-stress forces, and the fluid
@@ -36,27 +21,30 @@ inline typename Simulation<Dim, Shape>::Mat Simulation<Dim, Shape>::active_stres
 /// body force sum_p N_ip m_p g is m_i g: update_nodal_momentum adds it.)
 /// Locates each particle's stencil for the later phases of the step.
 template <int Dim, class Shape>
-inline void Simulation<Dim, Shape>::map_particles_to_grid(const Out& out, std::size_t begin,
-                                                          std::size_t end) {
+inline void map_particles_to_grid(StepContext<Dim, Shape>& ctx, const Scatter<Dim>& out,
+                                  std::size_t begin, std::size_t end) {
+  using StencilT = shape::Stencil<Dim, Shape>;
+  using Vec = VecD<Dim>;
+  using Mat = Eigen::Matrix<double, Dim, Dim>;
   if constexpr (StencilT::factorised) {
-    map_particles_to_grid_by_rows(out, begin, end);
+    map_particles_to_grid_by_rows(ctx, out, begin, end);
     return;
   }
   StencilT s;
-  NodeRange touched{grid_.count, -1};
+  NodeRange touched{ctx.grid.count, -1};
   // Local copies: Eigen's vector stores may alias anything for the
   // compiler, which otherwise reloads these pointers at every node.
   double* const mass_out = at<nodal::mass>(out);
   Vec* const momentum_out = at<nodal::momentum>(out);
   Vec* const force_out = at<nodal::force>(out);
   for (std::size_t p = begin; p < end; ++p) {
-    stencil_in_step<true, false>(p, s);
+    ctx.template stencil_in_step<true, false>(p, s);
     touched.lo = std::min(touched.lo, s.node[0]);  // stencil nodes are in increasing order
     touched.hi = std::max(touched.hi, s.node[StencilT::N - 1]);
-    const double m = particles_.mass[p];
-    const double vol = particles_.volume[p];
-    const Vec mv = m * particles_.v[p];
-    const Mat vol_sig = vol * active_stress(particles_.stress[p]);
+    const double m = ctx.particles.mass[p];
+    const double vol = ctx.particles.volume[p];
+    const Vec mv = m * ctx.particles.v[p];
+    const Mat vol_sig = vol * active_stress<Dim>(ctx.particles.stress[p]);
     // Row by row (K consecutive nodes along axis 0): the addresses of a row's
     // nodes are one base plus constants, not an index computation per node
     // and array. The same sums in the same order as node by node.
@@ -72,12 +60,12 @@ inline void Simulation<Dim, Shape>::map_particles_to_grid(const Out& out, std::s
         force_row[i].noalias() -= vol_sig * s.grad(r + i);
       }
     }
-    if (fluid_) {
-      const std::uint16_t mat = particles_.material[p];
-      if (!constants_[mat].saturated) continue;
-      const double n = particles_.porosity[p];
-      const double qv = ((1.0 - n) * inv_ks_[mat] + n * inv_kf_[mat]) * vol;
-      const double qvp = qv * particles_.pressure[p];
+    if (ctx.model.fluid) {
+      const std::uint16_t mat = ctx.particles.material[p];
+      if (!ctx.model.constants[mat].saturated) continue;
+      const double n = ctx.particles.porosity[p];
+      const double qv = ((1.0 - n) * ctx.model.inv_ks[mat] + n * ctx.model.inv_kf[mat]) * vol;
+      const double qvp = qv * ctx.particles.pressure[p];
       for (int k = 0; k < StencilT::N; ++k) {
         at<nodal::storage>(out)[s.node[k]] += s.w[k] * qv;
         at<nodal::pressure>(out)[s.node[k]] += s.w[k] * qvp;
@@ -92,21 +80,25 @@ inline void Simulation<Dim, Shape>::map_particles_to_grid(const Out& out, std::s
 /// aligned four-lane read-modify-writes per node), copied to the nodal sums
 /// after the loop.
 template <int Dim, class Shape>
-inline void Simulation<Dim, Shape>::map_particles_to_grid_by_rows(const Out& out, std::size_t begin,
-                                                                  std::size_t end) {
+inline void map_particles_to_grid_by_rows(StepContext<Dim, Shape>& ctx, const Scatter<Dim>& out,
+                                          std::size_t begin, std::size_t end) {
+  using StencilT = shape::Stencil<Dim, Shape>;
+  using AxesAhead = typename StepContext<Dim, Shape>::AxesAhead;
+  using Vec = VecD<Dim>;
+  using Mat = Eigen::Matrix<double, Dim, Dim>;
   if constexpr (StencilT::factorised) {  // (explicit instantiation compiles it for every shape)
-    NodeRange touched{grid_.count, -1};
+    NodeRange touched{ctx.grid.count, -1};
     using shape::Lanes;
     NodeRecord* const records = out.records;
     AxesAhead ahead;
     double* const storage_out = at<nodal::storage>(out);
     double* const pressure_out = at<nodal::pressure>(out);
     for (std::size_t p = begin; p < end; ++p) {
-      const auto& f = axes_ahead<false>(p, begin, end, ahead);
-      const double m = particles_.mass[p];
-      const double vol = particles_.volume[p];
-      const Vec mv = m * particles_.v[p];
-      const Mat vol_sig = vol * active_stress(particles_.stress[p]);
+      const auto& f = ctx.template axes_ahead<false>(p, begin, end, ahead);
+      const double m = ctx.particles.mass[p];
+      const double vol = ctx.particles.volume[p];
+      const Vec mv = m * ctx.particles.v[p];
+      const Mat vol_sig = vol * active_stress<Dim>(ctx.particles.stress[p]);
       // A node's record gains w [m, m v] and -vol sigma grad N (NodeRecord).
       Lanes mass_momentum = {m, 0.0, 0.0, 0.0};
       for (int a = 0; a < Dim; ++a) mass_momentum[1 + a] = mv[a];
@@ -124,20 +116,20 @@ inline void Simulation<Dim, Shape>::map_particles_to_grid_by_rows(const Out& out
         std::memcpy(r.a, &lanes_a, sizeof lanes_a);
         std::memcpy(r.b, &lanes_b, sizeof lanes_b);
       };
-      const std::uint16_t mat = particles_.material[p];
-      const bool fluid = fluid_ && constants_[mat].saturated;
+      const std::uint16_t mat = ctx.particles.material[p];
+      const bool fluid = ctx.model.fluid && ctx.model.constants[mat].saturated;
       double qv = 0.0, qvp = 0.0;  // storage Q V and Q V p
       if (fluid) {
-        const double n = particles_.porosity[p];
-        qv = ((1.0 - n) * inv_ks_[mat] + n * inv_kf_[mat]) * vol;
-        qvp = qv * particles_.pressure[p];
+        const double n = ctx.particles.porosity[p];
+        qv = ((1.0 - n) * ctx.model.inv_ks[mat] + n * ctx.model.inv_kf[mat]) * vol;
+        qvp = qv * ctx.particles.pressure[p];
       }
       touched.lo = std::min(touched.lo, f.first());
-      touched.hi = std::max(touched.hi, f.last(grid_.stride));
+      touched.hi = std::max(touched.hi, f.last(ctx.grid.stride));
       const Lanes wx0 = Lanes{} + f.w[0][0], wx1 = Lanes{} + f.w[0][1], wx2 = Lanes{} + f.w[0][2];
       const Lanes dx0 = Lanes{} + f.dw[0][0], dx1 = Lanes{} + f.dw[0][1],
                   dx2 = Lanes{} + f.dw[0][2];
-      f.for_rows(grid_.stride, [&](std::int64_t row, double wr, const auto& dr) {
+      f.for_rows(ctx.grid.stride, [&](std::int64_t row, double wr, const auto& dr) {
         const Lanes mm = wr * mass_momentum;
         const Lanes along = wr * column[0];
         Lanes across = dr[1] * column[1];
@@ -149,7 +141,7 @@ inline void Simulation<Dim, Shape>::map_particles_to_grid_by_rows(const Out& out
       });
       if (fluid) {
         const double wx[3] = {f.w[0][0], f.w[0][1], f.w[0][2]};
-        f.for_rows(grid_.stride, [&](std::int64_t row, double wr, const auto&) {
+        f.for_rows(ctx.grid.stride, [&](std::int64_t row, double wr, const auto&) {
           const double sq = wr * qv, sp = wr * qvp;
           for (int i = 0; i < 3; ++i) {
             storage_out[row + i] += wx[i] * sq;
@@ -176,15 +168,15 @@ inline void Simulation<Dim, Shape>::map_particles_to_grid_by_rows(const Out& out
 
 /// Surface loads at time t (boundary/tractions.hpp) added to the nodal force.
 template <int Dim, class Shape>
-inline void Simulation<Dim, Shape>::apply_surface_loads(double t) {
-  apply_tractions<Dim, Shape>(tractions_, particles_, grid_, t);
+inline void apply_surface_loads(StepContext<Dim, Shape>& ctx, double t) {
+  apply_tractions<Dim, Shape>(ctx.model.tractions, ctx.particles, ctx.grid, t);
 }
 
 template <int Dim, class Shape>
-inline void Simulation<Dim, Shape>::apply_boundary_fluxes(double t) {
+inline void apply_boundary_fluxes(StepContext<Dim, Shape>& ctx, double t) {
   // The nodes with storage: those the saturated particles reach.
-  apply_fluxes<Dim, Shape>(fluxes_, particles_, grid_, t,
-                           [this](std::int64_t i) { return grid_.storage[i] > 0.0; });
+  apply_fluxes<Dim, Shape>(ctx.model.fluxes, ctx.particles, ctx.grid, t,
+                           [&ctx](std::int64_t i) { return ctx.grid.storage[i] > 0.0; });
 }
 
 }  // namespace hmpm

@@ -15,33 +15,37 @@ namespace hmpm {
 /// Nodal pressure = storage-weighted average of particle pressures, then
 /// prescribed values at time t.
 template <int Dim, class Shape>
-inline void Simulation<Dim, Shape>::compute_nodal_pressure(double t) {
-  for_nodes([&](std::int64_t b, std::int64_t e) {
+inline void compute_nodal_pressure(StepContext<Dim, Shape>& ctx, double t) {
+  ctx.for_nodes([&](std::int64_t b, std::int64_t e) {
     for (std::int64_t i = b; i < e; ++i)
-      grid_.pressure[i] = grid_.storage[i] > 0 ? grid_.pressure[i] / grid_.storage[i] : 0.0;
+      ctx.grid.pressure[i] =
+          ctx.grid.storage[i] > 0 ? ctx.grid.pressure[i] / ctx.grid.storage[i] : 0.0;
   });
-  apply_pressure_constraints(constraints_, grid_, t);
-  apply_seepage_pressure(constraints_, grid_);
+  apply_pressure_constraints(ctx.model.constraints, ctx.grid, t);
+  apply_seepage_pressure(ctx.model.constraints, ctx.grid);
 }
 
 /// Phase 2 (saturated): the pore pressure interpolated from the nodes,
 /// p_hat = sum N_j p_j, enters the total stress: f_i += V p_hat grad N_i.
 template <int Dim, class Shape>
-inline void Simulation<Dim, Shape>::map_pore_pressure_force(const Out& out, std::size_t begin,
-                                                            std::size_t end) {
+inline void map_pore_pressure_force(StepContext<Dim, Shape>& ctx, const Scatter<Dim>& out,
+                                    std::size_t begin, std::size_t end) {
+  using StencilT = shape::Stencil<Dim, Shape>;
+  using AxesAhead = typename StepContext<Dim, Shape>::AxesAhead;
+  using Vec = VecD<Dim>;
   StencilT s;
   AxesAhead ahead;
   Vec* const force_out = at<nodal::force>(out);
   for (std::size_t p = begin; p < end; ++p) {
-    const auto& f = axes_ahead<true>(p, begin, end, ahead);
-    if (!constants_[particles_.material[p]].saturated) continue;
+    const auto& f = ctx.template axes_ahead<true>(p, begin, end, ahead);
+    if (!ctx.model.constants[ctx.particles.material[p]].saturated) continue;
     if constexpr (StencilT::factorised) {  // row by row (StencilT::Axes)
       double p_hat = 0.0;
-      f.for_rows(grid_.stride, [&](std::int64_t row, double wr, const auto&) {
-        p_hat += wr * f.row_sum(f.w[0], &grid_.pressure[row]);
+      f.for_rows(ctx.grid.stride, [&](std::int64_t row, double wr, const auto&) {
+        p_hat += wr * f.row_sum(f.w[0], &ctx.grid.pressure[row]);
       });
-      const double vp = particles_.volume[p] * p_hat;
-      f.for_rows(grid_.stride, [&](std::int64_t row, double wr, const auto& dr) {
+      const double vp = ctx.particles.volume[p] * p_hat;
+      f.for_rows(ctx.grid.stride, [&](std::int64_t row, double wr, const auto& dr) {
         // vp grad N of node i: (dw_i vp wr, w_i vp dr_1, ..)
         const double along = vp * wr;
         for (int i = 0; i < 3; ++i) {
@@ -51,10 +55,10 @@ inline void Simulation<Dim, Shape>::map_pore_pressure_force(const Out& out, std:
         }
       });
     } else {
-      stencil_in_step<true, true>(p, s);
+      ctx.template stencil_in_step<true, true>(p, s);
       double p_hat = 0.0;
-      for (int k = 0; k < StencilT::N; ++k) p_hat += s.w[k] * grid_.pressure[s.node[k]];
-      const double vp = particles_.volume[p] * p_hat;
+      for (int k = 0; k < StencilT::N; ++k) p_hat += s.w[k] * ctx.grid.pressure[s.node[k]];
+      const double vp = ctx.particles.volume[p] * p_hat;
       for (int k = 0; k < StencilT::N; ++k) force_out[s.node[k]] += vp * s.grad(k);
     }
   }
@@ -63,58 +67,60 @@ inline void Simulation<Dim, Shape>::map_pore_pressure_force(const Out& out, std:
 /// Grid: ds p/dt from the scattered flux (forward Euler: dp = dt flux /
 /// storage); free nodes advance, prescribed nodes take their value at t + dt.
 template <int Dim, class Shape>
-inline void Simulation<Dim, Shape>::update_nodal_pressure(double t_new, double dt) {
-  for_nodes([&](std::int64_t b, std::int64_t e) {
+inline void update_nodal_pressure(StepContext<Dim, Shape>& ctx, double t_new, double dt) {
+  ctx.for_nodes([&](std::int64_t b, std::int64_t e) {
     for (std::int64_t i = b; i < e; ++i)
-      grid_.dp[i] = grid_.storage[i] > 0 ? dt * grid_.flux[i] / grid_.storage[i] : 0.0;
+      ctx.grid.dp[i] = ctx.grid.storage[i] > 0 ? dt * ctx.grid.flux[i] / ctx.grid.storage[i] : 0.0;
   });
-  apply_pressure_increment_constraints(constraints_, grid_, t_new);
-  apply_seepage_increment(constraints_, grid_);
+  apply_pressure_increment_constraints(ctx.model.constraints, ctx.grid, t_new);
+  apply_seepage_increment(ctx.model.constraints, ctx.grid);
 }
 
 /// Phase 5 (saturated): particle pressure state += sum N dp_i (FLIP);
 /// reported pressure = sum N p_i^{n+1}; particles move.
 template <int Dim, class Shape>
-inline void Simulation<Dim, Shape>::update_particle_pressure_and_position(std::size_t begin,
-                                                                          std::size_t end,
-                                                                          double dt) {
+inline void update_particle_pressure_and_position(StepContext<Dim, Shape>& ctx, std::size_t begin,
+                                                  std::size_t end, double dt) {
+  using StencilT = shape::Stencil<Dim, Shape>;
+  using AxesAhead = typename StepContext<Dim, Shape>::AxesAhead;
+  using Vec = VecD<Dim>;
   StencilT s;
   AxesAhead ahead;
   for (std::size_t p = begin; p < end; ++p) {
-    const auto& f = axes_ahead</*Located=*/true, /*Grad=*/false>(p, begin, end, ahead);
-    const bool saturated = constants_[particles_.material[p]].saturated;
+    const auto& f = ctx.template axes_ahead</*Located=*/true, /*Grad=*/false>(p, begin, end, ahead);
+    const bool saturated = ctx.model.constants[ctx.particles.material[p]].saturated;
     // Weights only: this pass needs no gradient. v: the Lagrangian nodal
     // velocity at the particle, which moves it.
     double dp = 0.0, p_new = 0.0;
     Vec v = Vec::Zero();
     if constexpr (StencilT::factorised) {  // row by row (StencilT::Axes)
-      f.for_rows(grid_.stride, [&](std::int64_t row, double wr, const auto&) {
+      f.for_rows(ctx.grid.stride, [&](std::int64_t row, double wr, const auto&) {
         if (saturated) {
-          const double* const d = &grid_.dp[row];
-          const double* const pr = &grid_.pressure[row];
+          const double* const d = &ctx.grid.dp[row];
+          const double* const pr = &ctx.grid.pressure[row];
           const double pn[3] = {pr[0] + d[0], pr[1] + d[1], pr[2] + d[2]};
           dp += wr * f.row_sum(f.w[0], d);
           p_new += wr * f.row_sum(f.w[0], pn);
         }
-        f.add_scaled(v, wr, f.row_sum(f.w[0], &grid_.velocity[row]));
+        f.add_scaled(v, wr, f.row_sum(f.w[0], &ctx.grid.velocity[row]));
       });
     } else {
-      stencil_in_step<false, true>(p, s);
+      ctx.template stencil_in_step<false, true>(p, s);
       if (saturated) {
         for (int k = 0; k < StencilT::N; ++k) {
           const std::int64_t i = s.node[k];
-          dp += s.w[k] * grid_.dp[i];
-          p_new += s.w[k] * (grid_.pressure[i] + grid_.dp[i]);
+          dp += s.w[k] * ctx.grid.dp[i];
+          p_new += s.w[k] * (ctx.grid.pressure[i] + ctx.grid.dp[i]);
         }
       }
-      for (int k = 0; k < StencilT::N; ++k) v += s.w[k] * grid_.velocity[s.node[k]];
+      for (int k = 0; k < StencilT::N; ++k) v += s.w[k] * ctx.grid.velocity[s.node[k]];
     }
     if (saturated) {
-      particles_.pressure[p] += dp;
-      particles_.pressure_out[p] = p_new;
-      if (!std::isfinite(p_new)) fail_nonfinite(p, "pore pressure");
+      ctx.particles.pressure[p] += dp;
+      ctx.particles.pressure_out[p] = p_new;
+      if (!std::isfinite(p_new)) ctx.failures.nonfinite(p, "pore pressure");
     }
-    displace_particle(p, v, dt);
+    displace_particle(ctx, p, v, dt);
   }
 }
 

@@ -57,25 +57,27 @@ struct CouplingBox {
 /// the acceleration a* of update_nodal_momentum
 /// and w* = -k/gw (grad p^n - rho_f b + rho_f a*), scattered to nodal flux.
 template <int Dim, class Shape>
-inline void Simulation<Dim, Shape>::map_predicted_fluid_flux(const Out& out, std::size_t begin,
-                                                             std::size_t end) {
+inline void map_predicted_fluid_flux(StepContext<Dim, Shape>& ctx, const Scatter<Dim>& out,
+                                     std::size_t begin, std::size_t end) {
+  using StencilT = shape::Stencil<Dim, Shape>;
+  using Vec = VecD<Dim>;
   StencilT s;
   double* const flux_out = at<nodal::flux>(out);
   for (std::size_t p = begin; p < end; ++p) {
-    const MaterialConstants& mc = constants_[particles_.material[p]];
+    const MaterialConstants& mc = ctx.model.constants[ctx.particles.material[p]];
     if (!mc.saturated) continue;
-    stencil_in_step<true, true>(p, s);
+    ctx.template stencil_in_step<true, true>(p, s);
     double div_v = 0.0;
     Vec grad_p = Vec::Zero(), a = Vec::Zero();
     for (int k = 0; k < StencilT::N; ++k) {
       const std::int64_t i = s.node[k];
-      div_v += s.grad(k).dot(grid_.remap[i]);
-      grad_p += grid_.pressure[i] * s.grad(k);
-      a += s.w[k] * grid_.accel[i];
+      div_v += s.grad(k).dot(ctx.grid.remap[i]);
+      grad_p += ctx.grid.pressure[i] * s.grad(k);
+      a += s.w[k] * ctx.grid.accel[i];
     }
     const Vec w = -mc.permeability_over_gamma *
-                  (grad_p - mc.fluid_density * gravity_ + mc.darcy_inertia_density * a);
-    const double vol = particles_.volume[p];
+                  (grad_p - mc.fluid_density * ctx.model.gravity + mc.darcy_inertia_density * a);
+    const double vol = ctx.particles.volume[p];
     for (int k = 0; k < StencilT::N; ++k)
       flux_out[s.node[k]] += vol * (s.grad(k).dot(w) - s.w[k] * div_v);
   }
@@ -84,14 +86,16 @@ inline void Simulation<Dim, Shape>::map_predicted_fluid_flux(const Out& out, std
 /// The predicted particle velocities v_p + dt sum N a* re-mapped to the
 /// nodes (MUSL, as the strain will see them), scattered to nodal remap.
 template <int Dim, class Shape>
-inline void Simulation<Dim, Shape>::map_predicted_velocity(const Out& out, std::size_t begin,
-                                                           std::size_t end, double dt) {
+inline void map_predicted_velocity(StepContext<Dim, Shape>& ctx, const Scatter<Dim>& out,
+                                   std::size_t begin, std::size_t end, double dt) {
+  using StencilT = shape::Stencil<Dim, Shape>;
+  using Vec = VecD<Dim>;
   StencilT s;
   for (std::size_t p = begin; p < end; ++p) {
-    stencil_in_step<false, true>(p, s);
+    ctx.template stencil_in_step<false, true>(p, s);
     Vec a = Vec::Zero();
-    for (int k = 0; k < StencilT::N; ++k) a += s.w[k] * grid_.accel[s.node[k]];
-    const Vec mv = particles_.mass[p] * (particles_.v[p] + dt * a);
+    for (int k = 0; k < StencilT::N; ++k) a += s.w[k] * ctx.grid.accel[s.node[k]];
+    const Vec mv = ctx.particles.mass[p] * (ctx.particles.v[p] + dt * a);
     for (int k = 0; k < StencilT::N; ++k) at<nodal::remap>(out)[s.node[k]] += s.w[k] * mv;
   }
 }
@@ -105,20 +109,21 @@ inline void Simulation<Dim, Shape>::map_predicted_velocity(const Out& out, std::
 /// stencils reach (0 for the whole grid; a thread's private box covers its
 /// band of nodes only).
 template <int Dim, class Shape>
-inline void Simulation<Dim, Shape>::assemble_pressure_laplacian(std::size_t begin, std::size_t end,
-                                                                double dt, double* box,
-                                                                std::uint8_t* active,
-                                                                std::int64_t first) {
+inline void assemble_pressure_laplacian(StepContext<Dim, Shape>& ctx, std::size_t begin,
+                                        std::size_t end, double dt, double* box,
+                                        std::uint8_t* active, std::int64_t first) {
+  using StencilT = shape::Stencil<Dim, Shape>;
+  using Vec = VecD<Dim>;
   using Box = CouplingBox<Dim, Shape::K>;
   static_assert(Box::nodes == StencilT::N);
   static constexpr auto offsets = Box::offsets();
   StencilT s;
   for (std::size_t p = begin; p < end; ++p) {
-    const MaterialConstants& mc = constants_[particles_.material[p]];
+    const MaterialConstants& mc = ctx.model.constants[ctx.particles.material[p]];
     if (!mc.saturated) continue;
-    stencil_in_step<true, true>(p, s);
-    const double vol = particles_.volume[p];
-    const double rho = particles_.mass[p] / vol;
+    ctx.template stencil_in_step<true, true>(p, s);
+    const double vol = ctx.particles.volume[p];
+    const double rho = ctx.particles.mass[p] / vol;
     const double c = vol * (dt * dt / rho + dt * mc.permeability_over_gamma *
                                                 (1.0 - mc.darcy_inertia_density / rho));
     for (int k = 0; k < StencilT::N; ++k) {
@@ -137,16 +142,18 @@ inline void Simulation<Dim, Shape>::assemble_pressure_laplacian(std::size_t begi
 /// increment, V dp_hat grad N_i with dp_hat = sum_j N_j dp_j, scattered to
 /// nodal `remap` (used as scratch: the re-map has not started).
 template <int Dim, class Shape>
-inline void Simulation<Dim, Shape>::map_pressure_increment_force(const Out& out, std::size_t begin,
-                                                                 std::size_t end) {
+inline void map_pressure_increment_force(StepContext<Dim, Shape>& ctx, const Scatter<Dim>& out,
+                                         std::size_t begin, std::size_t end) {
+  using StencilT = shape::Stencil<Dim, Shape>;
+  using Vec = VecD<Dim>;
   StencilT s;
   Vec* const force_out = at<nodal::remap>(out);
   for (std::size_t p = begin; p < end; ++p) {
-    if (!constants_[particles_.material[p]].saturated) continue;
-    stencil_in_step<true, true>(p, s);
+    if (!ctx.model.constants[ctx.particles.material[p]].saturated) continue;
+    ctx.template stencil_in_step<true, true>(p, s);
     double dp_hat = 0.0;
-    for (int k = 0; k < StencilT::N; ++k) dp_hat += s.w[k] * grid_.dp[s.node[k]];
-    const double vdp = particles_.volume[p] * dp_hat;
+    for (int k = 0; k < StencilT::N; ++k) dp_hat += s.w[k] * ctx.grid.dp[s.node[k]];
+    const double vdp = ctx.particles.volume[p] * dp_hat;
     for (int k = 0; k < StencilT::N; ++k) force_out[s.node[k]] += vdp * s.grad(k);
   }
 }

@@ -43,71 +43,75 @@
 
 namespace hmpm {
 
-template <int Dim, class Shape>
-void Simulation<Dim, Shape>::setup_reactions() {
-  const auto nodes = static_cast<std::size_t>(grid_.count);
-  reaction_owner_.assign(nodes * Dim, -1);
+template <int Dim>
+void setup_reactions(ReactionTally& tally, const Constraints& constraints, std::int64_t node_count,
+                     std::size_t boundaries) {
+  const auto nodes = static_cast<std::size_t>(node_count);
+  std::vector<int>& owner = tally.owner;
+  owner.assign(nodes * Dim, -1);
   std::vector<std::uint8_t> prescribed(nodes * Dim, 0);
   std::vector<const std::uint8_t*> stuck(nodes * Dim, nullptr);
   auto charge = [&](std::int64_t i, int a, std::size_t b, bool fixed, const std::uint8_t* flag) {
     const std::size_t d = static_cast<std::size_t>(i) * Dim + static_cast<std::size_t>(a);
-    reaction_owner_[d] = static_cast<int>(b);
+    owner[d] = static_cast<int>(b);
     prescribed[d] = fixed ? 1 : 0;
     stuck[d] = flag;
   };
-  for (const AbsorbingConstraint& ab : constraints_.absorbing)
+  for (const AbsorbingConstraint& ab : constraints.absorbing)
     for (int a = 0; a < Dim; ++a)
       for (std::int64_t i : ab.nodes) charge(i, a, ab.boundary, false, nullptr);
-  for (const RigidTie& tie : constraints_.rigid_ties)
+  for (const RigidTie& tie : constraints.rigid_ties)
     for (int a = 0; a < Dim; ++a)
       if (tie.axes[a])
         for (std::int64_t i : tie.nodes) charge(i, a, tie.boundary, false, nullptr);
-  for (const VelocityConstraint& bc : constraints_.velocity)
+  for (const VelocityConstraint& bc : constraints.velocity)
     if (bc.has_friction())
       for (int a = 0; a < Dim; ++a)
         if (a != bc.normal)
           for (std::size_t k = 0; k < bc.nodes.size(); ++k)
             charge(bc.nodes[k], a, bc.boundary, false, &bc.stuck[k]);
-  for (const VelocityConstraint& bc : constraints_.velocity)
+  for (const VelocityConstraint& bc : constraints.velocity)
     for (int a = 0; a < Dim; ++a)
       if (bc.fixed[a])
         for (std::int64_t i : bc.nodes) charge(i, a, bc.boundary, true, nullptr);
-  charges_.clear();
+  tally.charges.clear();
   for (std::size_t d = 0; d < nodes * Dim; ++d)
-    if (reaction_owner_[d] >= 0)
-      charges_.push_back({static_cast<std::int64_t>(d / Dim), static_cast<int>(d % Dim),
-                          reaction_owner_[d], prescribed[d] != 0, stuck[d]});
-  charge_extra_.assign(charges_.size(), 0.0);
-  reaction_.assign(problem_.boundaries.size(), Vec3{0.0, 0.0, 0.0});
+    if (owner[d] >= 0)
+      tally.charges.push_back({static_cast<std::int64_t>(d / Dim), static_cast<int>(d % Dim),
+                               owner[d], prescribed[d] != 0, stuck[d]});
+  tally.extra.assign(tally.charges.size(), 0.0);
+  tally.force.assign(boundaries, Vec3{0.0, 0.0, 0.0});
 }
 
 template <int Dim, class Shape>
-void Simulation<Dim, Shape>::record_reaction_extra_force(const std::vector<Vec>& force) {
-  for (std::size_t c = 0; c < charges_.size(); ++c)
-    charge_extra_[c] = force[static_cast<std::size_t>(charges_[c].node)][charges_[c].axis];
+void record_reaction_extra_force(StepContext<Dim, Shape>& ctx,
+                                 const std::vector<VecD<Dim>>& force) {
+  for (std::size_t c = 0; c < ctx.reactions.charges.size(); ++c)
+    ctx.reactions.extra[c] = force[static_cast<std::size_t>(ctx.reactions.charges[c].node)]
+                                  [ctx.reactions.charges[c].axis];
 }
 
 template <int Dim, class Shape>
-void Simulation<Dim, Shape>::tally_reactions(bool with_extra) {
-  for (Vec3& r : reaction_) r = {0.0, 0.0, 0.0};
-  const double alpha = damping_;
-  for (std::size_t c = 0; c < charges_.size(); ++c) {
-    const ReactionCharge& ch = charges_[c];
+void tally_reactions(StepContext<Dim, Shape>& ctx, bool with_extra) {
+  for (Vec3& r : ctx.reactions.force) r = {0.0, 0.0, 0.0};
+  const double alpha = ctx.damping;
+  for (std::size_t c = 0; c < ctx.reactions.charges.size(); ++c) {
+    const ReactionCharge& ch = ctx.reactions.charges[c];
     const std::int64_t i = ch.node;
     const int a = ch.axis;
-    const double m = grid_.mass[i];
-    const double f = grid_.force[i][a] + m * gravity_[a];
-    double r = m * grid_.accel[i][a] - f;
+    const double m = ctx.grid.mass[i];
+    const double f = ctx.grid.force[i][a] + m * ctx.model.gravity[a];
+    double r = m * ctx.grid.accel[i][a] - f;
     if (!ch.prescribed && !(ch.stuck && *ch.stuck)) {
       // The free update these components started from was damped (a
       // sticking friction node replaces it, as a prescribed component
       // does), and a node without mass was left at rest unconstrained.
-      if (m <= mass_tolerance_) continue;
-      const double v0 = grid_.momentum[i][a] / m;
+      if (m <= ctx.model.mass_tolerance) continue;
+      const double v0 = ctx.grid.momentum[i][a] / m;
       r += alpha * std::abs(f) * (v0 > 0 ? 1.0 : (v0 < 0 ? -1.0 : 0.0));
     }
-    if (with_extra) r -= charge_extra_[c];
-    reaction_[static_cast<std::size_t>(ch.boundary)][static_cast<std::size_t>(a)] += r;
+    if (with_extra) r -= ctx.reactions.extra[c];
+    ctx.reactions.force[static_cast<std::size_t>(ch.boundary)][static_cast<std::size_t>(a)] += r;
   }
 }
 

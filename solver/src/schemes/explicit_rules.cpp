@@ -83,7 +83,7 @@ void check_explicit_step(const Problem& problem, const StableStep& s,
 }  // namespace
 
 const SchemeRules& explicit_scheme_rules() {
-  static const SchemeRules rules{"explicit", explicit_stable_step, check_explicit_step};
+  static const SchemeRules rules{explicit_stable_step, check_explicit_step};
   return rules;
 }
 

@@ -24,10 +24,10 @@ namespace hmpm {
 template <int Dim, class Shape>
 class ExplicitScheme final : public TimeScheme {
  public:
-  using Sim = Simulation<Dim, Shape>;
-  using Out = typename Sim::Out;
+  using Context = StepContext<Dim, Shape>;
+  using Out = Scatter<Dim>;
 
-  explicit ExplicitScheme(Sim& sim) : sim_(sim) {}
+  explicit ExplicitScheme(Context c) : c_(c) {}
 
   StableStep stable_step(const Problem& problem) const override {
     return explicit_scheme_rules().stable_step(problem);
@@ -37,21 +37,21 @@ class ExplicitScheme final : public TimeScheme {
   /// the first problem.
   void step(double t, double dt) override {
     if (!set_local_damping(t)) return;
-    sim_.clear_grid();
+    hmpm::clear_grid(c_);
     map_particles_to_grid();
-    if (sim_.fluid_) {
-      sim_.compute_nodal_pressure(t);
+    if (c_.model.fluid) {
+      hmpm::compute_nodal_pressure(c_, t);
       map_pore_pressure_force();
     }
-    sim_.apply_surface_loads(t);
-    sim_.update_nodal_momentum(t, dt);
-    if (sim_.reactions_due_) sim_.tally_reactions(/*with_extra=*/false);
+    hmpm::apply_surface_loads(c_, t);
+    hmpm::update_nodal_momentum(c_, t, dt);
+    if (c_.reactions.due) hmpm::tally_reactions(c_, /*with_extra=*/false);
     update_particle_velocities_and_remap(dt);
-    sim_.compute_remapped_nodal_velocity(t + dt, dt);
+    hmpm::compute_remapped_nodal_velocity(c_, t + dt, dt);
     update_particle_stress_and_fluid_flux(dt);
-    if (sim_.fluid_) {
-      sim_.apply_boundary_fluxes(t);
-      sim_.update_nodal_pressure(t + dt, dt);
+    if (c_.model.fluid) {
+      hmpm::apply_boundary_fluxes(c_, t);
+      hmpm::update_nodal_pressure(c_, t + dt, dt);
       update_particle_pressure_and_position(dt);
     }
   }
@@ -60,63 +60,62 @@ class ExplicitScheme final : public TimeScheme {
   /// The local damping coefficient of the step; false (a failure of the
   /// run, before the step changes anything) outside [0, 1).
   bool set_local_damping(double t) {
-    const Problem& problem = sim_.problem_;
-    sim_.damping_ = problem.local_damping ? problem.local_damping(t) : 0.0;
-    if (sim_.damping_ >= 0.0 && sim_.damping_ < 1.0) return true;
-    sim_.fail_run("local_damping is " + Sim::number(sim_.damping_) + " at t = " + Sim::number(t) +
-                      " s, outside [0, 1)",
-                  "keep the local_damping formula between 0 and 1 (exclusive) at all times");
+    const Problem& problem = c_.model.problem;
+    c_.damping = problem.local_damping ? problem.local_damping(t) : 0.0;
+    if (c_.damping >= 0.0 && c_.damping < 1.0) return true;
+    c_.failures.fail_run(
+        "local_damping is " + number(c_.damping) + " at t = " + number(t) + " s, outside [0, 1)",
+        "keep the local_damping formula between 0 and 1 (exclusive) at all times");
     return false;
   }
 
   // The particle phases, over the threads, with the nodal sums each scatters.
   void map_particles_to_grid() {
     using namespace nodal;
-    const unsigned sums =
-        bit(mass) | bit(momentum) | bit(force) | (sim_.fluid_ ? bit(storage) | bit(pressure) : 0u);
-    sim_.for_particles(sums, [&](const Out& out, std::size_t b, std::size_t e) {
-      sim_.map_particles_to_grid(out, b, e);
+    const unsigned sums = bit(mass) | bit(momentum) | bit(force) |
+                          (c_.model.fluid ? bit(storage) | bit(pressure) : 0u);
+    c_.for_particles(sums, [&](const Out& out, std::size_t b, std::size_t e) {
+      hmpm::map_particles_to_grid(c_, out, b, e);
     });
   }
   void map_pore_pressure_force() {
-    sim_.for_particles(nodal::bit(nodal::force), [&](const Out& out, std::size_t b, std::size_t e) {
-      sim_.map_pore_pressure_force(out, b, e);
+    c_.for_particles(nodal::bit(nodal::force), [&](const Out& out, std::size_t b, std::size_t e) {
+      hmpm::map_pore_pressure_force(c_, out, b, e);
     });
   }
   void update_particle_velocities_and_remap(double dt) {
-    sim_.for_particles(nodal::bit(nodal::remap), [&](const Out& out, std::size_t b, std::size_t e) {
-      sim_.update_particle_velocities_and_remap(out, b, e, dt);
+    c_.for_particles(nodal::bit(nodal::remap), [&](const Out& out, std::size_t b, std::size_t e) {
+      hmpm::update_particle_velocities_and_remap(c_, out, b, e, dt);
     });
   }
   void update_particle_stress_and_fluid_flux(double dt) {
-    if (sim_.fluid_) {
-      sim_.for_particles(nodal::bit(nodal::flux), [&](const Out& out, std::size_t b,
-                                                      std::size_t e) {
-        if (sim_.plastic_)
-          sim_.template update_particle_stress_and_fluid_flux</*Fluid=*/true, /*Plastic=*/true>(
-              out, b, e, dt);
+    if (c_.model.fluid) {
+      c_.for_particles(nodal::bit(nodal::flux), [&](const Out& out, std::size_t b, std::size_t e) {
+        if (c_.model.plastic)
+          hmpm::update_particle_stress_and_fluid_flux</*Fluid=*/true, /*Plastic=*/true>(c_, out, b,
+                                                                                        e, dt);
         else
-          sim_.template update_particle_stress_and_fluid_flux</*Fluid=*/true, /*Plastic=*/false>(
-              out, b, e, dt);
+          hmpm::update_particle_stress_and_fluid_flux</*Fluid=*/true, /*Plastic=*/false>(c_, out, b,
+                                                                                         e, dt);
       });
     } else {
-      sim_.for_particles(0u, [&](const Out& out, std::size_t b, std::size_t e) {
-        if (sim_.plastic_)
-          sim_.template update_particle_stress_and_fluid_flux</*Fluid=*/false, /*Plastic=*/true>(
-              out, b, e, dt);
+      c_.for_particles(0u, [&](const Out& out, std::size_t b, std::size_t e) {
+        if (c_.model.plastic)
+          hmpm::update_particle_stress_and_fluid_flux</*Fluid=*/false, /*Plastic=*/true>(c_, out, b,
+                                                                                         e, dt);
         else
-          sim_.template update_particle_stress_and_fluid_flux</*Fluid=*/false, /*Plastic=*/false>(
-              out, b, e, dt);
+          hmpm::update_particle_stress_and_fluid_flux</*Fluid=*/false, /*Plastic=*/false>(c_, out,
+                                                                                          b, e, dt);
       });
     }
   }
   void update_particle_pressure_and_position(double dt) {
-    sim_.for_particles(0u, [&](const Out&, std::size_t b, std::size_t e) {
-      sim_.update_particle_pressure_and_position(b, e, dt);
+    c_.for_particles(0u, [&](const Out&, std::size_t b, std::size_t e) {
+      hmpm::update_particle_pressure_and_position(c_, b, e, dt);
     });
   }
 
-  Sim& sim_;
+  Context c_;
 };
 
 }  // namespace hmpm

@@ -16,7 +16,4 @@ StepGrowth quasi_static_growth(const Problem& problem);
 /// Steps of the geometric plan g to reach `end` (ignoring output landings).
 std::int64_t growth_step_count(const StepGrowth& g, double end);
 
-/// The rules of the quasi-static scheme (quasi_static_rules.cpp).
-const SchemeRules& quasi_static_scheme_rules();
-
 }  // namespace hmpm

@@ -113,7 +113,7 @@ void check_quasi_static(const Problem& problem, const StableStep&,
 }  // namespace
 
 const SchemeRules& quasi_static_scheme_rules() {
-  static const SchemeRules rules{"quasi_static", quasi_static_stable_step, check_quasi_static};
+  static const SchemeRules rules{quasi_static_stable_step, check_quasi_static};
   return rules;
 }
 

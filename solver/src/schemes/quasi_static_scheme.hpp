@@ -82,25 +82,25 @@ namespace hmpm {
 template <int Dim, class Shape>
 class QuasiStaticScheme final : public TimeScheme {
  public:
-  using Sim = Simulation<Dim, Shape>;
+  using Context = StepContext<Dim, Shape>;
   using Vec = VecD<Dim>;
   using Mat = Eigen::Matrix<double, Dim, Dim>;
   using StencilT = shape::Stencil<Dim, Shape>;
   static constexpr int N = StencilT::N;
   static constexpr int L = N * (Dim + 1);  ///< local unknowns of one particle
 
-  explicit QuasiStaticScheme(Sim& sim) : sim_(sim) {
-    const Problem& pr = sim_.problem_;
+  explicit QuasiStaticScheme(Context c) : c_(c) {
+    const Problem& pr = c_.model.problem;
     if (!pr.time.dt) {
       growth_ = quasi_static_growth(pr);
       nominal_ = growth_.initial;
     }
-    for (const MaterialConstants& mc : sim_.constants_)
+    for (const MaterialConstants& mc : c_.model.constants)
       e_ref_ = std::max(e_ref_, mc.constrained_modulus);
     if (!(e_ref_ > 0)) e_ref_ = 1.0;
-    for (const SeepageFace& face : sim_.constraints_.seepage)
+    for (const SeepageFace& face : c_.model.constraints.seepage)
       seepage_.insert(seepage_.end(), face.nodes.begin(), face.nodes.end());
-    held_.assign(static_cast<std::size_t>(sim_.grid_.count), 0);
+    held_.assign(static_cast<std::size_t>(c_.grid.count), 0);
   }
 
   StableStep stable_step(const Problem& problem) const override {
@@ -111,7 +111,7 @@ class QuasiStaticScheme final : public TimeScheme {
   /// output instant, or stretched by up to a quarter to reach it.
   double next_dt(double t) override {
     double h = nominal_;
-    const OutputRequest& out = sim_.problem_.output;
+    const OutputRequest& out = c_.model.problem.output;
     const ConsolidationRequest& c = out.consolidation;
     // (first instant, interval) of each output's samples
     const std::pair<double, double> samples[] = {{0.0, out.series_interval},
@@ -132,7 +132,7 @@ class QuasiStaticScheme final : public TimeScheme {
   }
 
   void step(double t, double dt) override {
-    const ImplicitControl& c = sim_.problem_.time.implicit;
+    const ImplicitControl& c = c_.model.problem.time.implicit;
     const double t_end = t + dt;
     double t_cur = t, h = dt;
     int cuts = 0;
@@ -142,18 +142,18 @@ class QuasiStaticScheme final : public TimeScheme {
         t_cur += hh;
         continue;
       }
-      if (sim_.failed_) return;
+      if (c_.failures.failed) return;
       if (cuts >= c.max_cutbacks) {
         std::ostringstream what;
         what << "the quasi-static Newton iterations did not converge in " << c.max_iterations
-             << " iterations after " << cuts << " cut-backs (step length down to "
-             << Sim::number(hh) << " s): residual reached |R_u|/|f| = " << Sim::number(last_ru_)
-             << ", |R_p|/|terms| = " << Sim::number(last_rp_) << " (tolerance "
-             << Sim::number(c.tolerance) << ")";
-        sim_.fail_run(what.str(),
-                      "start with a smaller step (time.dt, or time.dt.initial with growth), "
-                      "loosen time.implicit.tolerance, or allow more "
-                      "time.implicit.max_iterations or time.implicit.max_cutbacks");
+             << " iterations after " << cuts << " cut-backs (step length down to " << number(hh)
+             << " s): residual reached |R_u|/|f| = " << number(last_ru_)
+             << ", |R_p|/|terms| = " << number(last_rp_) << " (tolerance " << number(c.tolerance)
+             << ")";
+        c_.failures.fail_run(what.str(),
+                             "start with a smaller step (time.dt, or time.dt.initial with growth), "
+                             "loosen time.implicit.tolerance, or allow more "
+                             "time.implicit.max_iterations or time.implicit.max_cutbacks");
         return;
       }
       ++cuts;
@@ -161,7 +161,7 @@ class QuasiStaticScheme final : public TimeScheme {
       h = 0.5 * hh;
     }
     // After cut-backs the next steps start again from the length that worked.
-    if (cuts > 0 && !sim_.problem_.time.dt) nominal_ = std::min(nominal_, h);
+    if (cuts > 0 && !c_.model.problem.time.dt) nominal_ = std::min(nominal_, h);
   }
 
   void report(RunResult& result) const override {
@@ -202,8 +202,8 @@ class QuasiStaticScheme final : public TimeScheme {
   /// cells of the stabilisation and the sparsity pattern, for the particles
   /// where they are now (once per step; cut-backs reuse them).
   void prepare() {
-    auto& grid = sim_.grid_;
-    auto& parts = sim_.particles_;
+    auto& grid = c_.grid;
+    auto& parts = c_.particles;
     const auto nodes = static_cast<std::size_t>(grid.count);
     const std::size_t np = parts.size();
     weight_.assign(nodes, 0.0);
@@ -213,10 +213,10 @@ class QuasiStaticScheme final : public TimeScheme {
     StencilT s;
     keys_.resize(np);
     for (std::size_t p = 0; p < np; ++p) {
-      sim_.template stencil_in_step<true, false>(p, s);
+      c_.template stencil_in_step<true, false>(p, s);
       const double vol = parts.volume[p];
       vmax = std::max(vmax, vol);
-      const bool sat = sim_.fluid_ && sim_.constants_[parts.material[p]].saturated;
+      const bool sat = c_.model.fluid && c_.model.constants[parts.material[p]].saturated;
       for (int k = 0; k < N; ++k) {
         weight_[s.node[k]] += s.w[k] * vol;
         if (sat) {
@@ -233,12 +233,12 @@ class QuasiStaticScheme final : public TimeScheme {
     udof_.assign(nodes * Dim, -1);
     pdof_.assign(nodes, -1);
     ufixed_.assign(nodes * Dim, 0);
-    for (const VelocityConstraint& bc : sim_.constraints_.velocity)
+    for (const VelocityConstraint& bc : c_.model.constraints.velocity)
       for (int a = 0; a < Dim; ++a)
         if (bc.fixed[a])
           for (std::int64_t i : bc.nodes) ufixed_[static_cast<std::size_t>(i) * Dim + a] = 1;
     std::int64_t n = 0;
-    for (const RigidTie& tie : sim_.constraints_.rigid_ties)
+    for (const RigidTie& tie : c_.model.constraints.rigid_ties)
       for (int a = 0; a < Dim; ++a) {
         if (!tie.axes[a]) continue;
         std::int64_t shared = -1;
@@ -251,7 +251,7 @@ class QuasiStaticScheme final : public TimeScheme {
         }
       }
     pfixed_.assign(nodes, 0);
-    for (const PressureConstraint& bc : sim_.constraints_.pressure)
+    for (const PressureConstraint& bc : c_.model.constraints.pressure)
       for (std::int64_t i : bc.nodes) pfixed_[static_cast<std::size_t>(i)] = 1;
     for (std::int64_t i : seepage_)
       if (held_[static_cast<std::size_t>(i)]) pfixed_[static_cast<std::size_t>(i)] = 1;
@@ -279,7 +279,7 @@ class QuasiStaticScheme final : public TimeScheme {
     system_.begin_pattern(unknowns_);
     std::int64_t dofs[L];
     for (std::size_t p = 0; p < np; ++p) {
-      sim_.template stencil_in_step<false, true>(p, s);
+      c_.template stencil_in_step<false, true>(p, s);
       local_dofs(s, dofs);
       for (int r = 0; r < L; ++r) {
         if (dofs[r] < 0) continue;
@@ -287,13 +287,13 @@ class QuasiStaticScheme final : public TimeScheme {
           if (dofs[c] >= 0) system_.add_pattern(dofs[r], dofs[c]);
       }
     }
-    system_.finish_pattern(sim_.problem_.time.implicit.linear_solver,
-                           sim_.problem_.time.implicit.linear_tolerance);
+    system_.finish_pattern(c_.model.problem.time.implicit.linear_solver,
+                           c_.model.problem.time.implicit.linear_tolerance);
     rhs_.resize(unknowns_);
     ref_.resize(unknowns_);
     // Private sums of threads 1.. (zero between assemblies; no allocation
     // once the vectors have reached the largest pattern).
-    partial_.resize(sim_.pool_ ? static_cast<std::size_t>(sim_.pool_->size() - 1) : 0);
+    partial_.resize(c_.threads.pool ? static_cast<std::size_t>(c_.threads.pool->size() - 1) : 0);
     for (Partial& w : partial_) {
       w.rhs.assign(static_cast<std::size_t>(unknowns_), 0.0);
       w.ref.assign(static_cast<std::size_t>(unknowns_), 0.0);
@@ -308,18 +308,18 @@ class QuasiStaticScheme final : public TimeScheme {
   /// The projection term tau (M - m m^T / V) of the saturated particles
   /// keys_[b, e) (one stencil anchor).
   void add_cell(std::size_t b, std::size_t e) {
-    auto& parts = sim_.particles_;
-    const double factor = sim_.problem_.time.implicit.pressure_stabilisation;
-    if (!sim_.fluid_ || !(factor > 0)) return;
+    auto& parts = c_.particles;
+    const double factor = c_.model.problem.time.implicit.pressure_stabilisation;
+    if (!c_.model.fluid || !(factor > 0)) return;
     Eigen::Matrix<double, N, N> m = Eigen::Matrix<double, N, N>::Zero();
     Eigen::Matrix<double, N, 1> mv = Eigen::Matrix<double, N, 1>::Zero();
     double vol = 0.0, tau = 0.0;
     StencilT s;
     for (std::size_t k = b; k < e; ++k) {
       const auto p = static_cast<std::size_t>(keys_[k].second);
-      const MaterialConstants& mc = sim_.constants_[parts.material[p]];
+      const MaterialConstants& mc = c_.model.constants[parts.material[p]];
       if (!mc.saturated) continue;
-      sim_.template stencil_in_step<false, true>(p, s);
+      c_.template stencil_in_step<false, true>(p, s);
       const double v = parts.volume[p];
       for (int i = 0; i < N; ++i) {
         mv[i] += v * s.w[i];
@@ -351,18 +351,18 @@ class QuasiStaticScheme final : public TimeScheme {
   /// particles are then updated); false otherwise, with nothing changed.
   bool attempt(double t, double h) {
     if (!prepared_) prepare();
-    auto& grid = sim_.grid_;
+    auto& grid = c_.grid;
     const auto nodes = static_cast<std::size_t>(grid.count);
     // Prescribed values and the initial guess (du = 0, p = p^n).
     std::fill(du_.begin(), du_.end(), 0.0);
-    for (const VelocityConstraint& bc : sim_.constraints_.velocity)
+    for (const VelocityConstraint& bc : c_.model.constraints.velocity)
       for (int a = 0; a < Dim; ++a)
         if (bc.fixed[a]) {
           const double d = 0.5 * ((*bc.fn[a])(t) + (*bc.fn[a])(t + h)) * h;
           for (std::int64_t i : bc.nodes) du_[static_cast<std::size_t>(i) * Dim + a] = d;
         }
     for (std::size_t i = 0; i < nodes; ++i) p_[i] = pn_[i];
-    for (const PressureConstraint& bc : sim_.constraints_.pressure)
+    for (const PressureConstraint& bc : c_.model.constraints.pressure)
       bc.for_values(t + h, [&](std::int64_t i, double v) { p_[static_cast<std::size_t>(i)] = v; });
     for (std::int64_t i : seepage_)
       if (held_[static_cast<std::size_t>(i)]) p_[static_cast<std::size_t>(i)] = 0.0;
@@ -370,14 +370,14 @@ class QuasiStaticScheme final : public TimeScheme {
     for (std::size_t i = 0; i < nodes; ++i) grid.force[i].setZero();
     apply_dead_loads(t + h);
     // Water across faces at t + h (backward Euler), on the initial face areas.
-    if (!sim_.fluxes_.empty()) {
+    if (!c_.model.fluxes.empty()) {
       std::fill(grid.flux.begin(), grid.flux.end(), 0.0);
       // The nodes the saturated particles reach (free or prescribed).
       apply_fluxes<Dim, Shape, /*DeadLoad=*/true>(
-          sim_.fluxes_, sim_.particles_, grid, t + h,
+          c_.model.fluxes, c_.particles, grid, t + h,
           [this](std::int64_t i) { return weight_fluid_[static_cast<std::size_t>(i)] > tiny_; });
     }
-    const ImplicitControl& c = sim_.problem_.time.implicit;
+    const ImplicitControl& c = c_.model.problem.time.implicit;
     history_.resize(static_cast<std::size_t>(c.max_iterations) + 1);  // no-op after the first
     for (int it = 0;; ++it) {
       const bool converged = assemble(h, /*jacobian=*/it < c.max_iterations);
@@ -402,13 +402,13 @@ class QuasiStaticScheme final : public TimeScheme {
         if (it > max_nonlinear_ || worst_.empty())
           worst_.assign(history_.begin(), history_.begin() + it + 1);
         max_nonlinear_ = std::max(max_nonlinear_, it);
-        if (sim_.reactions_due_) tally_reactions();
+        if (c_.reactions.due) tally_reactions();
         commit(h);
         if (!seepage_.empty()) {
           std::fill(held_.begin(), held_.end(), 0);
           prepared_ = false;
         }
-        return !sim_.failed_;
+        return !c_.failures.failed;
       }
       if (it >= c.max_iterations) return false;
       if (!system_.solve(rhs_, x_)) return false;
@@ -429,7 +429,7 @@ class QuasiStaticScheme final : public TimeScheme {
   /// load by the top particle's strain; Terzaghi's and Mandel's loads are
   /// fixed forces).
   void apply_dead_loads(double t) {
-    apply_tractions<Dim, Shape, /*DeadLoad=*/true>(sim_.tractions_, sim_.particles_, sim_.grid_, t);
+    apply_tractions<Dim, Shape, /*DeadLoad=*/true>(c_.model.tractions, c_.particles, c_.grid, t);
   }
 
   /// The particle's strain increment and trial-then-returned stress for the
@@ -453,16 +453,16 @@ class QuasiStaticScheme final : public TimeScheme {
       de[4] = 0.5 * (g(1, 2) + g(2, 1));
       de[5] = 0.5 * (g(2, 0) + g(0, 2));
     }
-    const MaterialConstants& mc = sim_.constants_[sim_.particles_.material[p]];
-    sig = sim_.particles_.stress[p];
+    const MaterialConstants& mc = c_.model.constants[c_.particles.material[p]];
+    sig = c_.particles.stress[p];
     if constexpr (Dim >= 2) rotate_jaumann<Dim>(sig, g, 1.0);
     const double tr = de[0] + de[1] + de[2];
     for (int c = 0; c < 3; ++c) sig[c] += mc.lambda * tr + 2.0 * mc.shear_modulus * de[c];
     for (int c = 3; c < 6; ++c) sig[c] += 2.0 * mc.shear_modulus * de[c];
-    if (!sim_.plastic_) return false;
+    if (!c_.model.plastic) return false;
     if (d_alg && mc.model != Model::linear_elastic)
-      return return_with_tangent(sig, mc, {sim_.particles_.internal.data(), p}, *d_alg) > 0.0;
-    const double norm = return_to_yield_surface(sig, mc, {sim_.particles_.internal.data(), p});
+      return return_with_tangent(sig, mc, {c_.particles.internal.data(), p}, *d_alg) > 0.0;
+    const double norm = return_to_yield_surface(sig, mc, {c_.particles.internal.data(), p});
     if (plastic) *plastic = norm;
     return false;
   }
@@ -498,8 +498,8 @@ class QuasiStaticScheme final : public TimeScheme {
   /// Residual (rhs_ = scaled R, ref_ = the sums of the magnitudes of its
   /// terms) and, when `jacobian`, the Jacobian. True when converged.
   bool assemble(double h, bool jacobian) {
-    auto& parts = sim_.particles_;
-    auto& grid = sim_.grid_;
+    auto& parts = c_.particles;
+    auto& grid = c_.grid;
     rhs_.setZero();
     ref_.setZero();
     if (jacobian) system_.zero_values();
@@ -513,7 +513,7 @@ class QuasiStaticScheme final : public TimeScheme {
         ref_[d] += std::abs(grid.force[i][a]) * inv_e;
       }
     // Water across faces: the mass balance loses h times the inflow.
-    if (!sim_.fluxes_.empty())
+    if (!c_.model.fluxes.empty())
       for (std::size_t i = 0; i < static_cast<std::size_t>(grid.count); ++i) {
         const std::int64_t d = pdof_[i];
         if (d < 0) continue;
@@ -537,7 +537,7 @@ class QuasiStaticScheme final : public TimeScheme {
     if (partial_.empty()) {
       chunk(0, 0, parts.size());
     } else {
-      sim_.pool_->for_ranges(parts.size(), chunk);
+      c_.threads.pool->for_ranges(parts.size(), chunk);
       double* values = system_.values();
       const auto unknowns = static_cast<std::size_t>(unknowns_);
       const auto entries = static_cast<std::size_t>(system_.nonzeros());
@@ -558,7 +558,8 @@ class QuasiStaticScheme final : public TimeScheme {
         }
       };
       const std::size_t n = std::max(unknowns, jacobian ? entries : 0);
-      sim_.pool_->for_blocks(n, sim_.block_of(n, Sim::node_block), reduce);
+      c_.threads.pool->for_blocks(n, c_.threads.block_of(n, Threads<Dim, Shape>::node_block),
+                                  reduce);
     }
     // Pressure stabilisation on the increment p - p^n.
     const std::size_t cells = cell_nodes_.size() / N;
@@ -599,7 +600,7 @@ class QuasiStaticScheme final : public TimeScheme {
     }
     last_ru_ = fu > 0 ? std::sqrt(ru / fu) : 0.0;
     last_rp_ = fp > 0 ? std::sqrt(rp / fp) : 0.0;
-    const double tol = sim_.problem_.time.implicit.tolerance;
+    const double tol = c_.model.problem.time.implicit.tolerance;
     return last_ru_ <= tol && last_rp_ <= tol;
   }
 
@@ -608,26 +609,26 @@ class QuasiStaticScheme final : public TimeScheme {
   /// (laid out as UpSystem::values()).
   void assemble_particles(std::size_t begin, std::size_t end, double h, bool jacobian, double* rhs,
                           double* ref, double* values) {
-    auto& parts = sim_.particles_;
+    auto& parts = c_.particles;
     const double inv_e = 1.0 / e_ref_;
-    const Vec gravity = sim_.gravity_;
+    const Vec gravity = c_.model.gravity;
     StencilT s;
     std::int64_t dofs[L];
     Eigen::Matrix<double, L, L> a_loc;
     constitutive::Tangent d_alg;
     Eigen::Matrix<double, NC, Dim> db[N];  // tangent times the strain of node l
-    const bool consistent_off = sim_.problem_.time.implicit.elastic_tangent;
+    const bool consistent_off = c_.model.problem.time.implicit.elastic_tangent;
     for (std::size_t p = begin; p < end; ++p) {
-      sim_.template stencil_in_step<true, true>(p, s);
+      c_.template stencil_in_step<true, true>(p, s);
       local_dofs(s, dofs);
-      const MaterialConstants& mc = sim_.constants_[parts.material[p]];
-      const bool sat = sim_.fluid_ && mc.saturated;
+      const MaterialConstants& mc = c_.model.constants[parts.material[p]];
+      const bool sat = c_.model.fluid && mc.saturated;
       Mat g;
       Voigt de, sig;
       const bool plastic =
           particle_stress(p, s, g, de, sig, jacobian && !consistent_off ? &d_alg : nullptr);
       const double vol = parts.volume[p], m = parts.mass[p];
-      const Mat vs = vol * Sim::active_stress(sig);
+      const Mat vs = vol * active_stress<Dim>(sig);
       double p_hat = 0.0, div = g.trace();
       Vec grad_p = Vec::Zero();
       if (sat)
@@ -636,8 +637,8 @@ class QuasiStaticScheme final : public TimeScheme {
           p_hat += s.w[k] * pk;
           grad_p += pk * s.grad(k);
         }
-      const double storage = sat ? (1.0 - parts.porosity[p]) * sim_.inv_ks_[parts.material[p]] +
-                                       parts.porosity[p] * sim_.inv_kf_[parts.material[p]]
+      const double storage = sat ? (1.0 - parts.porosity[p]) * c_.model.inv_ks[parts.material[p]] +
+                                       parts.porosity[p] * c_.model.inv_kf[parts.material[p]]
                                  : 0.0;
       const double kg = sat ? mc.permeability_over_gamma : 0.0;
       const Vec flow = grad_p - mc.fluid_density * gravity;
@@ -718,24 +719,24 @@ class QuasiStaticScheme final : public TimeScheme {
   /// residual, zero within the tolerance. Serial over the particles, on
   /// the steps the time loop samples only.
   void tally_reactions() {
-    auto& parts = sim_.particles_;
-    const auto& grid = sim_.grid_;
-    const std::vector<int>& owner = sim_.reaction_owner_;
-    std::vector<Vec3>& reaction = sim_.reaction_;
+    auto& parts = c_.particles;
+    const auto& grid = c_.grid;
+    const std::vector<int>& owner = c_.reactions.owner;
+    std::vector<Vec3>& reaction = c_.reactions.force;
     for (Vec3& r : reaction) r = {0.0, 0.0, 0.0};
-    for (const auto& ch : sim_.charges_)  // the tractions at t + h
+    for (const auto& ch : c_.reactions.charges)  // the tractions at t + h
       reaction[static_cast<std::size_t>(ch.boundary)][static_cast<std::size_t>(ch.axis)] -=
           grid.force[ch.node][ch.axis];
-    const Vec gravity = sim_.gravity_;
+    const Vec gravity = c_.model.gravity;
     StencilT s;
     for (std::size_t p = 0; p < parts.size(); ++p) {
-      sim_.template stencil_in_step<true, true>(p, s);
+      c_.template stencil_in_step<true, true>(p, s);
       Mat g;
       Voigt de, sig;
       particle_stress(p, s, g, de, sig);
-      const bool sat = sim_.fluid_ && sim_.constants_[parts.material[p]].saturated;
+      const bool sat = c_.model.fluid && c_.model.constants[parts.material[p]].saturated;
       const double vol = parts.volume[p], m = parts.mass[p];
-      const Mat vs = vol * Sim::active_stress(sig);
+      const Mat vs = vol * active_stress<Dim>(sig);
       double p_hat = 0.0;
       if (sat)
         for (int k = 0; k < N; ++k) p_hat += s.w[k] * p_[static_cast<std::size_t>(s.node[k])];
@@ -757,18 +758,18 @@ class QuasiStaticScheme final : public TimeScheme {
   /// porosity, pressure and Darcy velocity of du and p, and move by N du.
   void commit(double h) {
     // Each particle's update is its own (no sums): blocks on any thread.
-    sim_.for_particles(0u, [&](const auto&, std::size_t begin, std::size_t end) {
+    c_.for_particles(0u, [&](const auto&, std::size_t begin, std::size_t end) {
       commit_particles(begin, end, h);
     });
     prepared_ = false;
   }
 
   void commit_particles(std::size_t begin, std::size_t end, double h) {
-    auto& parts = sim_.particles_;
-    auto& grid = sim_.grid_;
+    auto& parts = c_.particles;
+    auto& grid = c_.grid;
     StencilT s;
     for (std::size_t p = begin; p < end; ++p) {
-      sim_.template stencil_in_step<true, true>(p, s);
+      c_.template stencil_in_step<true, true>(p, s);
       Mat g;
       Voigt de, sig;
       double plastic = 0.0;
@@ -778,15 +779,15 @@ class QuasiStaticScheme final : public TimeScheme {
       parts.strain[p] += de;
       Mat f = Mat::Identity() + g;
       const double j = f.determinant();
-      if (!(j > 0.0)) sim_.fail_volume(p, j);
+      if (!(j > 0.0)) c_.failures.volume(p, j);
       parts.volume[p] *= j;
-      const MaterialConstants& mc = sim_.constants_[parts.material[p]];
+      const MaterialConstants& mc = c_.model.constants[parts.material[p]];
       Vec dx = Vec::Zero();
       for (int k = 0; k < N; ++k) {
         const auto i = static_cast<std::size_t>(s.node[k]);
         for (int a = 0; a < Dim; ++a) dx[a] += s.w[k] * du_[i * Dim + a];
       }
-      if (sim_.fluid_ && mc.saturated) {
+      if (c_.model.fluid && mc.saturated) {
         parts.porosity[p] = 1.0 - (1.0 - parts.porosity[p]) / j;
         double p_hat = 0.0;
         Vec grad_p = Vec::Zero();
@@ -797,25 +798,26 @@ class QuasiStaticScheme final : public TimeScheme {
         }
         parts.pressure[p] = p_hat;
         parts.pressure_out[p] = p_hat;
-        parts.darcy[p] = -mc.permeability_over_gamma * (grad_p - mc.fluid_density * sim_.gravity_);
-        if (!std::isfinite(p_hat)) sim_.fail_nonfinite(p, "pore pressure");
+        parts.darcy[p] =
+            -mc.permeability_over_gamma * (grad_p - mc.fluid_density * c_.model.gravity);
+        if (!std::isfinite(p_hat)) c_.failures.nonfinite(p, "pore pressure");
       }
       parts.v[p] = dx / h;
       Vec& x = parts.x[p];
       x += dx;
       bool inside = x.allFinite();
       for (int a = 0; a < Dim; ++a)
-        inside = inside && x[a] >= grid.origin[a] && x[a] <= sim_.grid_max_[a];
+        inside = inside && x[a] >= grid.origin[a] && x[a] <= c_.model.grid_max[a];
       if (!inside) {
         if (!x.allFinite())
-          sim_.fail_nonfinite(p, "displacement");
+          c_.failures.nonfinite(p, "displacement");
         else
-          sim_.fail_left_grid(p);
+          c_.failures.left_grid(p);
       }
     }
   }
 
-  Sim& sim_;
+  Context c_;
   StepGrowth growth_;
   double nominal_ = 0.0;
   double e_ref_ = 0.0;

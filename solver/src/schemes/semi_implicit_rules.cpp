@@ -67,8 +67,7 @@ void check_semi_implicit_step(const Problem& problem, const StableStep& s,
 }  // namespace
 
 const SchemeRules& semi_implicit_scheme_rules() {
-  static const SchemeRules rules{"semi_implicit", semi_implicit_stable_step,
-                                 check_semi_implicit_step};
+  static const SchemeRules rules{semi_implicit_stable_step, check_semi_implicit_step};
   return rules;
 }
 

@@ -60,14 +60,14 @@ namespace hmpm {
 template <int Dim, class Shape>
 class SemiImplicitScheme final : public TimeScheme {
  public:
-  using Sim = Simulation<Dim, Shape>;
-  using Out = typename Sim::Out;
-  using Vec = typename Sim::Vec;
+  using Context = StepContext<Dim, Shape>;
+  using Out = Scatter<Dim>;
+  using Vec = VecD<Dim>;
   using Box = CouplingBox<Dim, Shape::K>;
 
-  explicit SemiImplicitScheme(Sim& sim) : sim_(sim) {
-    if (!sim_.fluid_) return;
-    const auto n = static_cast<std::size_t>(sim_.grid_.count);
+  explicit SemiImplicitScheme(Context c) : c_(c) {
+    if (!c_.model.fluid) return;
+    const auto n = static_cast<std::size_t>(c_.grid.count);
     box_.assign(n * Box::size, 0.0);
     active_.assign(n, 0);
     prescribed_.assign(n, 0);
@@ -76,12 +76,12 @@ class SemiImplicitScheme final : public TimeScheme {
     rhs_.assign(n, 0.0);
     x_.assign(n, 0.0);
     last_dp_.assign(n, 0.0);
-    for (const PressureConstraint& bc : sim_.constraints_.pressure)
+    for (const PressureConstraint& bc : c_.model.constraints.pressure)
       for (std::int64_t i : bc.nodes) prescribed_[static_cast<std::size_t>(i)] = 1;
-    for (const SeepageFace& face : sim_.constraints_.seepage)
+    for (const SeepageFace& face : c_.model.constraints.seepage)
       seepage_.insert(seepage_.end(), face.nodes.begin(), face.nodes.end());
     for (int o = 0; o < Box::size; ++o)
-      node_offset_[static_cast<std::size_t>(o)] = Box::node_offset(o, sim_.grid_.stride);
+      node_offset_[static_cast<std::size_t>(o)] = Box::node_offset(o, c_.grid.stride);
   }
 
   StableStep stable_step(const Problem& problem) const override {
@@ -90,25 +90,25 @@ class SemiImplicitScheme final : public TimeScheme {
 
   void step(double t, double dt) override {
     if (!set_local_damping(t)) return;
-    sim_.clear_grid();
+    hmpm::clear_grid(c_);
     map_particles_to_grid();
-    if (sim_.fluid_) {
-      sim_.compute_nodal_pressure(t);
+    if (c_.model.fluid) {
+      hmpm::compute_nodal_pressure(c_, t);
       map_pore_pressure_force();
     }
-    sim_.apply_surface_loads(t);
-    sim_.update_nodal_momentum(t, dt);  // the predictor v*, a*
-    if (sim_.fluid_) {
+    hmpm::apply_surface_loads(c_, t);
+    hmpm::update_nodal_momentum(c_, t, dt);  // the predictor v*, a*
+    if (c_.model.fluid) {
       if (!solve_pressure_increment(t, dt)) return;
       correct_nodal_momentum(t, dt);
     }
     // Reactions with the corrector's pressure-increment force (kept by
     // correct_nodal_momentum) among the nodal forces.
-    if (sim_.reactions_due_) sim_.tally_reactions(/*with_extra=*/sim_.fluid_);
+    if (c_.reactions.due) hmpm::tally_reactions(c_, /*with_extra=*/c_.model.fluid);
     update_particle_velocities_and_remap(dt);
-    sim_.compute_remapped_nodal_velocity(t + dt, dt);
+    hmpm::compute_remapped_nodal_velocity(c_, t + dt, dt);
     update_particle_stress(dt);
-    if (sim_.fluid_) update_particle_pressure_and_position(dt);
+    if (c_.model.fluid) update_particle_pressure_and_position(dt);
   }
 
   void report(RunResult& result) const override {
@@ -130,12 +130,12 @@ class SemiImplicitScheme final : public TimeScheme {
 
  private:
   bool set_local_damping(double t) {
-    const Problem& problem = sim_.problem_;
-    sim_.damping_ = problem.local_damping ? problem.local_damping(t) : 0.0;
-    if (sim_.damping_ >= 0.0 && sim_.damping_ < 1.0) return true;
-    sim_.fail_run("local_damping is " + Sim::number(sim_.damping_) + " at t = " + Sim::number(t) +
-                      " s, outside [0, 1)",
-                  "keep the local_damping formula between 0 and 1 (exclusive) at all times");
+    const Problem& problem = c_.model.problem;
+    c_.damping = problem.local_damping ? problem.local_damping(t) : 0.0;
+    if (c_.damping >= 0.0 && c_.damping < 1.0) return true;
+    c_.failures.fail_run(
+        "local_damping is " + number(c_.damping) + " at t = " + number(t) + " s, outside [0, 1)",
+        "keep the local_damping formula between 0 and 1 (exclusive) at all times");
     return false;
   }
 
@@ -144,29 +144,29 @@ class SemiImplicitScheme final : public TimeScheme {
   /// predicted re-mapped velocity while F is scattered, then is zeroed
   /// again (the step's re-map proper comes later).
   bool solve_pressure_increment(double t, double dt) {
-    auto& grid = sim_.grid_;
+    auto& grid = c_.grid;
     dt_ = dt;
-    sim_.for_particles(nodal::bit(nodal::remap), [&](const Out& out, std::size_t b, std::size_t e) {
-      sim_.map_predicted_velocity(out, b, e, dt);
+    c_.for_particles(nodal::bit(nodal::remap), [&](const Out& out, std::size_t b, std::size_t e) {
+      hmpm::map_predicted_velocity(c_, out, b, e, dt);
     });
-    const double tol = sim_.mass_tolerance_;
-    sim_.for_nodes([&](std::int64_t b, std::int64_t e) {
+    const double tol = c_.model.mass_tolerance;
+    c_.for_nodes([&](std::int64_t b, std::int64_t e) {
       for (std::int64_t i = b; i < e; ++i) {
         const double m = grid.mass[i];
         grid.remap[i] = m > tol ? Vec(grid.remap[i] / m) : Vec::Zero();
       }
     });
-    apply_remap_constraints(sim_.constraints_, grid, tol, t + dt);
-    sim_.for_particles(nodal::bit(nodal::flux), [&](const Out& out, std::size_t b, std::size_t e) {
-      sim_.map_predicted_fluid_flux(out, b, e);
+    apply_remap_constraints(c_.model.constraints, grid, tol, t + dt);
+    c_.for_particles(nodal::bit(nodal::flux), [&](const Out& out, std::size_t b, std::size_t e) {
+      hmpm::map_predicted_fluid_flux(c_, out, b, e);
     });
-    sim_.apply_boundary_fluxes(t + dt);
-    sim_.for_nodes([&](std::int64_t b, std::int64_t e) {
+    hmpm::apply_boundary_fluxes(c_, t + dt);
+    c_.for_nodes([&](std::int64_t b, std::int64_t e) {
       for (std::int64_t i = b; i < e; ++i) grid.remap[i].setZero();
     });
     assemble_laplacian(dt);
     std::fill(grid.dp.begin(), grid.dp.end(), 0.0);
-    apply_pressure_increment_constraints(sim_.constraints_, grid, t + dt);
+    apply_pressure_increment_constraints(c_.model.constraints, grid, t + dt);
     // Seepage faces: an active set. Every face node starts free (no water
     // enters a free node); a node the solve would raise above p = 0 is held
     // there (dp = -p: the water that would raise it leaves) and the system
@@ -200,7 +200,7 @@ class SemiImplicitScheme final : public TimeScheme {
   /// and solves it into grid dp; false (a failure of the run) when the
   /// solve fails.
   bool solve_once() {
-    auto& grid = sim_.grid_;
+    auto& grid = c_.grid;
     const double dt = dt_;
     // Unknowns: active, free nodes with a positive diagonal, in node order.
     const std::int64_t count = grid.count;
@@ -244,11 +244,12 @@ class SemiImplicitScheme final : public TimeScheme {
     Eigen::Map<const Eigen::VectorXd> b(rhs_.data(), n);
     Eigen::Map<Eigen::VectorXd> x(x_.data(), n);
     if (!b.allFinite()) {
-      sim_.fail_run("the predicted velocity or fluid flux became non-finite: the run diverged",
-                    failure_hint(true));
+      c_.failures.fail_run(
+          "the predicted velocity or fluid flux became non-finite: the run diverged",
+          failure_hint(true));
       return false;
     }
-    const ImplicitControl& control = sim_.problem_.time.implicit;
+    const ImplicitControl& control = c_.model.problem.time.implicit;
     const PressureSystem::Outcome r =
         system_.solve(b, x, control.linear_solver, control.linear_tolerance, Dim);
     ++solves_;
@@ -259,13 +260,13 @@ class SemiImplicitScheme final : public TimeScheme {
         what += "the sparse LDL^T factorisation failed or gave a non-finite increment";
       } else {
         what += "conjugate gradients reached a relative residual of ";
-        what += Sim::number(r.residual);
+        what += number(r.residual);
         what += " after ";
         what += std::to_string(r.iterations);
         what += " iterations";
       }
       what += ")";
-      sim_.fail_run(std::move(what), failure_hint(r.direct));
+      c_.failures.fail_run(std::move(what), failure_hint(r.direct));
       return false;
     }
     for (int c = 0; c < n; ++c) {
@@ -280,7 +281,7 @@ class SemiImplicitScheme final : public TimeScheme {
   /// the linear solver).
   std::string failure_hint(bool direct) const {
     std::string hint = "reduce time.dt or time.courant (the stable step estimate is ";
-    hint += Sim::number(sim_.stable_.limit);
+    hint += number(c_.model.stable.limit);
     hint += " s), and check moduli, densities, permeabilities and loads for unrealistic values";
     if (!direct) hint += ", or ask for the direct linear solver";
     return hint;
@@ -291,13 +292,13 @@ class SemiImplicitScheme final : public TimeScheme {
   /// other force: prescribed components keep their values, ties and
   /// friction see the corrected velocity).
   void correct_nodal_momentum(double t, double dt) {
-    auto& grid = sim_.grid_;
-    sim_.for_particles(nodal::bit(nodal::remap), [&](const Out& out, std::size_t b, std::size_t e) {
-      sim_.map_pressure_increment_force(out, b, e);
+    auto& grid = c_.grid;
+    c_.for_particles(nodal::bit(nodal::remap), [&](const Out& out, std::size_t b, std::size_t e) {
+      hmpm::map_pressure_increment_force(c_, out, b, e);
     });
-    if (sim_.reactions_due_) sim_.record_reaction_extra_force(grid.remap);
-    const double tol = sim_.mass_tolerance_;
-    sim_.for_nodes([&](std::int64_t b, std::int64_t e) {
+    if (c_.reactions.due) hmpm::record_reaction_extra_force(c_, grid.remap);
+    const double tol = c_.model.mass_tolerance;
+    c_.for_nodes([&](std::int64_t b, std::int64_t e) {
       for (std::int64_t i = b; i < e; ++i) {
         const double m = grid.mass[i];
         if (m > tol) {
@@ -308,60 +309,60 @@ class SemiImplicitScheme final : public TimeScheme {
         grid.remap[i].setZero();
       }
     });
-    apply_velocity_constraints(sim_.constraints_, grid, tol, t, dt);
+    apply_velocity_constraints(c_.model.constraints, grid, tol, t, dt);
   }
 
   // The particle phases, as in the explicit scheme.
   void map_particles_to_grid() {
     using namespace nodal;
-    const unsigned sums =
-        bit(mass) | bit(momentum) | bit(force) | (sim_.fluid_ ? bit(storage) | bit(pressure) : 0u);
-    sim_.for_particles(sums, [&](const Out& out, std::size_t b, std::size_t e) {
-      sim_.map_particles_to_grid(out, b, e);
+    const unsigned sums = bit(mass) | bit(momentum) | bit(force) |
+                          (c_.model.fluid ? bit(storage) | bit(pressure) : 0u);
+    c_.for_particles(sums, [&](const Out& out, std::size_t b, std::size_t e) {
+      hmpm::map_particles_to_grid(c_, out, b, e);
     });
   }
   void map_pore_pressure_force() {
-    sim_.for_particles(nodal::bit(nodal::force), [&](const Out& out, std::size_t b, std::size_t e) {
-      sim_.map_pore_pressure_force(out, b, e);
+    c_.for_particles(nodal::bit(nodal::force), [&](const Out& out, std::size_t b, std::size_t e) {
+      hmpm::map_pore_pressure_force(c_, out, b, e);
     });
   }
   void update_particle_velocities_and_remap(double dt) {
-    sim_.for_particles(nodal::bit(nodal::remap), [&](const Out& out, std::size_t b, std::size_t e) {
-      sim_.update_particle_velocities_and_remap(out, b, e, dt);
+    c_.for_particles(nodal::bit(nodal::remap), [&](const Out& out, std::size_t b, std::size_t e) {
+      hmpm::update_particle_velocities_and_remap(c_, out, b, e, dt);
     });
   }
   void update_particle_stress(double dt) {
-    sim_.for_particles(0u, [&](const Out& out, std::size_t b, std::size_t e) {
-      if (sim_.fluid_) {
-        if (sim_.plastic_)
-          sim_.template update_particle_stress_and_fluid_flux<true, true, false>(out, b, e, dt);
+    c_.for_particles(0u, [&](const Out& out, std::size_t b, std::size_t e) {
+      if (c_.model.fluid) {
+        if (c_.model.plastic)
+          hmpm::update_particle_stress_and_fluid_flux<true, true, false>(c_, out, b, e, dt);
         else
-          sim_.template update_particle_stress_and_fluid_flux<true, false, false>(out, b, e, dt);
+          hmpm::update_particle_stress_and_fluid_flux<true, false, false>(c_, out, b, e, dt);
       } else {
-        if (sim_.plastic_)
-          sim_.template update_particle_stress_and_fluid_flux<false, true>(out, b, e, dt);
+        if (c_.model.plastic)
+          hmpm::update_particle_stress_and_fluid_flux<false, true>(c_, out, b, e, dt);
         else
-          sim_.template update_particle_stress_and_fluid_flux<false, false>(out, b, e, dt);
+          hmpm::update_particle_stress_and_fluid_flux<false, false>(c_, out, b, e, dt);
       }
     });
   }
   void update_particle_pressure_and_position(double dt) {
-    sim_.for_particles(0u, [&](const Out&, std::size_t b, std::size_t e) {
-      sim_.update_particle_pressure_and_position(b, e, dt);
+    c_.for_particles(0u, [&](const Out&, std::size_t b, std::size_t e) {
+      hmpm::update_particle_pressure_and_position(c_, b, e, dt);
     });
   }
 
   /// The Laplacian into box_ and active_, over one fixed chunk of particles
   /// per thread (the chunks of the step's first phase, whose band of nodes
-  /// Simulation::touched_ records): thread 0 straight into box_, thread t >
+  /// Threads::touched records): thread 0 straight into box_, thread t >
   /// 0 into a private box over its band, added to box_ after the loop,
   /// node by node in thread order, and cleared: the sums are reproducible
   /// for a given thread count.
   void assemble_laplacian(double dt) {
-    const std::size_t threads = sim_.touched_.size();
+    const std::size_t threads = c_.threads.touched.size();
     bands_.resize(threads);
     for (std::size_t t = 1; t < threads; ++t) {
-      const NodeRange r = sim_.touched_[t];
+      const NodeRange r = c_.threads.touched[t];
       Band& band = bands_[t];
       band.first = r.lo;
       const auto nodes = static_cast<std::size_t>(std::max<std::int64_t>(0, r.hi - r.lo + 1));
@@ -372,18 +373,19 @@ class SemiImplicitScheme final : public TimeScheme {
     }
     auto chunk = [&](int t, std::size_t b, std::size_t e) {
       if (t == 0) {
-        sim_.assemble_pressure_laplacian(b, e, dt, box_.data(), active_.data(), 0);
+        hmpm::assemble_pressure_laplacian(c_, b, e, dt, box_.data(), active_.data(), 0);
         return;
       }
       Band& band = bands_[static_cast<std::size_t>(t)];
-      sim_.assemble_pressure_laplacian(b, e, dt, band.box.data(), band.active.data(), band.first);
+      hmpm::assemble_pressure_laplacian(c_, b, e, dt, band.box.data(), band.active.data(),
+                                        band.first);
     };
-    sim_.pool_->for_ranges(sim_.particles_.size(), chunk);
+    c_.threads.pool->for_ranges(c_.particles.size(), chunk);
     if (threads < 2) return;
-    std::int64_t lo = sim_.grid_.count, hi = -1;
+    std::int64_t lo = c_.grid.count, hi = -1;
     for (std::size_t t = 1; t < threads; ++t) {
-      lo = std::min(lo, sim_.touched_[t].lo);
-      hi = std::max(hi, sim_.touched_[t].hi);
+      lo = std::min(lo, c_.threads.touched[t].lo);
+      hi = std::max(hi, c_.threads.touched[t].hi);
     }
     if (hi < lo) return;
     auto reduce = [&](int, std::size_t b, std::size_t e) {
@@ -391,7 +393,7 @@ class SemiImplicitScheme final : public TimeScheme {
         Band& band = bands_[t];
         const std::int64_t first = std::max(lo + static_cast<std::int64_t>(b), band.first);
         const std::int64_t last =
-            std::min(lo + static_cast<std::int64_t>(e), sim_.touched_[t].hi + 1);
+            std::min(lo + static_cast<std::int64_t>(e), c_.threads.touched[t].hi + 1);
         for (std::int64_t i = first; i < last; ++i) {
           const auto u = static_cast<std::size_t>(i), v = static_cast<std::size_t>(i - band.first);
           if (!band.active[v]) continue;
@@ -407,10 +409,11 @@ class SemiImplicitScheme final : public TimeScheme {
       }
     };
     const auto nodes = static_cast<std::size_t>(hi - lo + 1);
-    sim_.pool_->for_blocks(nodes, sim_.block_of(nodes, Sim::node_block), reduce);
+    c_.threads.pool->for_blocks(nodes, c_.threads.block_of(nodes, Threads<Dim, Shape>::node_block),
+                                reduce);
   }
 
-  Sim& sim_;
+  Context c_;
   PressureSystem system_;
   // Per node (saturated runs): the Laplacian's couplings (zero between
   // steps), a saturated stencil touched it this step, a prescribed pressure,

@@ -14,8 +14,9 @@
 //   explicit_scheme.hpp      + explicit_rules.cpp       forward Euler u-p, MUSL
 //   semi_implicit_scheme.hpp + semi_implicit_rules.cpp  explicit momentum, implicit pressure
 //   quasi_static_scheme.hpp  + quasi_static_rules.cpp   implicit u-p without inertia
-// A new scheme adds its enum value (hmpm::Scheme, problem.hpp), a case in
-// scheme_rules() (schemes/rules.cpp) and in make_scheme() (time_loop.hpp).
+// A new scheme adds its enum value (hmpm::Scheme, problem.hpp) and its row
+// in the table of schemes (schemes/table.hpp: name, rules, constructor, what
+// it reports).
 #pragma once
 
 #include <cmath>
@@ -51,7 +52,6 @@ class TimeScheme {
 
 /// The rules of a scheme that need only the Problem.
 struct SchemeRules {
-  const char* name;
   /// Stable step and the dt the run will use (StableStep::chosen).
   StableStep (*stable_step)(const Problem& problem);
   /// Appends the issues that make `problem` unrunnable under the scheme
@@ -63,12 +63,14 @@ struct SchemeRules {
 const SchemeRules& explicit_scheme_rules();
 /// The rules of the semi-implicit scheme (schemes/semi_implicit_rules.cpp).
 const SchemeRules& semi_implicit_scheme_rules();
+/// The rules of the quasi-static scheme (schemes/quasi_static_rules.cpp).
+const SchemeRules& quasi_static_scheme_rules();
 
 /// Per material of `problem`: some body of it has particles (only those
 /// limit a stable step); every material when none has (explicit_rules.cpp).
 std::vector<bool> materials_with_particles(const Problem& problem);
 
-/// The rules of the scheme `problem` runs with (problem.time.scheme).
+/// The rules of the scheme `problem` runs with (problem.time.scheme; schemes/table.cpp).
 const SchemeRules& scheme_rules(const Problem& problem);
 
 /// Steps of length dt to reach `end`, the last one shortened to end there.
