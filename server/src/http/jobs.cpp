@@ -348,7 +348,7 @@ void get_job_log(Context& c, const httplib::Request& req, httplib::Response& res
     return send_problem(res, 410, "job-dismissed", "Job dismissed",
                         "the job was deleted; its log went with its results");
   }
-  std::ifstream in(c.workers.job_dir(job->id) / run_log_name, std::ios::binary);
+  std::ifstream in(c.files.log_file(job->id), std::ios::binary);
   std::ostringstream text;
   if (in) text << in.rdbuf();  // no file yet: the job has not started
   res.set_content(text.str(), "text/plain; charset=utf-8");
@@ -366,7 +366,7 @@ void cancel_job(Context& c, const httplib::Request& req, httplib::Response& res)
                             "); nothing was changed",
                         Json{{"jobID", id}, {"jobStatus", status_name(before->status)}});
   }
-  append_run_log(c.workers.job_dir(id),
+  append_run_log(c.files.job_dir(id),
                  std::string("cancelled by the client while ") + status_name(before->status));
   log_dismissal(id, before->status, "cancel");
   // A worker of this process records the files written so far; give it a
@@ -384,10 +384,7 @@ void dismiss_job(Context& c, const httplib::Request& req, httplib::Response& res
   const auto before = c.store.dismiss(id);
   if (!before) return send_no_such_job(res, id);
   // A worker of this process removes the files itself once it has stopped.
-  if (!c.workers.cancel(id) && !before->results_deleted) {
-    std::error_code ec;
-    std::filesystem::remove_all(c.workers.job_dir(id), ec);
-  }
+  if (!c.workers.cancel(id) && !before->results_deleted) c.files.remove(id);
   if (before->status != JobStatus::dismissed) log_dismissal(id, before->status, "delete");
   const auto after = c.store.find(id);
   if (!after) return send_no_such_job(res, id);
