@@ -33,7 +33,6 @@ struct RecoveryDecision {
   std::string failure;
 };
 
-RecoveryDecision decide_recovery(const LapsedAttempt& job, int max_attempts,
-                                 double charge_after_s);
+RecoveryDecision decide_recovery(const LapsedAttempt& job, int max_attempts, double charge_after_s);
 
 }  // namespace hmpm::server

@@ -110,7 +110,7 @@ class Attempt {
       resume_ = read_checkpoint(dir_, *recorded, *parsed.job, job_.spec, why);
       if (!resume_) {
         append_run_log(dir_, "checkpoint at step " + std::to_string(recorded->step) +
-                                " not usable (" + why + "): starting from step 0");
+                                 " not usable (" + why + "): starting from step 0");
         log_line({{"event", "checkpoint"}, {"job", job_.id}, {"unusable", why}});
       }
     }
@@ -138,14 +138,14 @@ class Attempt {
     }
     if (!resume_) remove_all_but_log(dir_);  // leftovers of interrupted attempts
     append_run_log(dir_, "attempt " + std::to_string(job_.attempts) + " started on " +
-                            settings_.claimant.instance + ": " +
-                            std::to_string(job_.cost.particles) + " particles, " +
-                            std::to_string(job_.cost.steps) + " steps, " +
-                            std::to_string(settings_.threads_per_job) + " solver threads");
+                             settings_.claimant.instance + ": " +
+                             std::to_string(job_.cost.particles) + " particles, " +
+                             std::to_string(job_.cost.steps) + " steps, " +
+                             std::to_string(settings_.threads_per_job) + " solver threads");
     if (resume_) {
       append_run_log(dir_, "resumed from the checkpoint at step " + std::to_string(recorded->step) +
-                              ", t = " + short_number(recorded->time) + " s (" + recorded->file +
-                              ", written " + recorded->written + ")");
+                               ", t = " + short_number(recorded->time) + " s (" + recorded->file +
+                               ", written " + recorded->written + ")");
       log_line({{"event", "checkpoint"}, {"job", job_.id}, {"resumed_step", recorded->step}});
     }
   }
@@ -189,9 +189,9 @@ class Attempt {
     const auto now = SteadyClock::now();
     if (pacer_.due(p.fraction, now)) {
       append_run_log(dir_, "progress " + std::to_string(whole(100.0 * p.fraction)) + " %: step " +
-                              std::to_string(p.step) + " of " + std::to_string(p.total_steps) +
-                              ", t = " + short_number(p.time) + " of " + short_number(p.end_time) +
-                              " s, " + short_number(seconds_since(t0_)) + " s wall");
+                               std::to_string(p.step) + " of " + std::to_string(p.total_steps) +
+                               ", t = " + short_number(p.time) + " of " + short_number(p.end_time) +
+                               " s, " + short_number(seconds_since(t0_)) + " s wall");
     }
     if (now - last_write_ < std::chrono::duration<double>(0.5 * settings_.progress_interval_s))
       return;
@@ -229,8 +229,8 @@ class Attempt {
       }
       checkpoint_file_ = name;
       append_run_log(dir_, "checkpoint at step " + std::to_string(c.step) + ", t = " +
-                              short_number(c.time) + " s: " + std::to_string(c.bytes.size()) +
-                              " bytes in " + short_number(seconds_since(t1)) + " s");
+                               short_number(c.time) + " s: " + std::to_string(c.bytes.size()) +
+                               " bytes in " + short_number(seconds_since(t1)) + " s");
     } catch (const std::exception& e) {  // the run goes on; the last checkpoint stays
       std::error_code ec;
       std::filesystem::remove(dir_ / name, ec);
