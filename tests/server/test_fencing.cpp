@@ -36,7 +36,7 @@
 #include "job_log.hpp"
 #include "metrics.hpp"
 #include "support.hpp"
-#include "worker_pool.hpp"
+#include "workers/pool.hpp"
 
 namespace hmpm::server {
 namespace {
@@ -200,7 +200,7 @@ TEST(Fencing, ARevivedServerCannotChangeTheFilesOfTheAttemptThatFinished) {
   ASSERT_TRUE(done);
   EXPECT_EQ(done->owner, "server-b");
   EXPECT_GT(done->lease_token, token_a);
-  const auto served = b.results_dir(*done);
+  const auto served = b.files().results_dir(*done);
   EXPECT_EQ(served, data / id / ("attempt-" + std::to_string(done->lease_token)));
   const auto manifest = store->results(id);
   ASSERT_FALSE(manifest.empty());

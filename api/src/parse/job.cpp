@@ -99,7 +99,8 @@ void read_root(ParseContext& c, const json& root) {
     r.error(c.first_pore_pressure_bc, "prescribes pore pressure but no material has 'hydraulic'");
 }
 
-ParseResult parse_text(std::string_view text, const Limits& limits) {
+ParseResult parse_text(std::string_view text, const Limits& limits,
+                       const Calibration& calibration) {
   ParseResult result;
   if (text.size() > static_cast<std::size_t>(limits.max_body_bytes)) {
     result.errors.push_back({"", "spec is " + std::to_string(text.size()) +
@@ -109,7 +110,7 @@ ParseResult parse_text(std::string_view text, const Limits& limits) {
   }
   json root;
   if (!parse_json_guarded(text, limits.max_json_depth, root, result.errors)) return result;
-  ParseContext c(limits);
+  ParseContext c(limits, calibration);
   read_root(c, root);
   if (c.r.error_count() == 0) check_whole_problem(c);
   result.errors = std::move(c.r.errors());
@@ -123,7 +124,7 @@ ParseResult parse_text(std::string_view text, const Limits& limits) {
     ParsedJob job;
     job.name = c.name;
     job.profiles = std::move(c.profiles);
-    job.cost = estimate_cost(c.p);
+    job.cost = c.cost ? std::move(*c.cost) : estimate_cost(c.p, calibration);
     job.warnings = std::move(c.warnings);
     for (const ProblemIssue& w : problem_warnings(c.p))
       job.warnings.push_back({pointer_of_solver_location(w.where), w.message});
@@ -159,9 +160,10 @@ const std::vector<SpecObjectKeys>& spec_object_keys() {
   return table;
 }
 
-ParseResult parse_job(std::string_view json_text, const Limits& limits) {
+ParseResult parse_job(std::string_view json_text, const Limits& limits,
+                      const Calibration& calibration) {
   try {
-    return parse::parse_text(json_text, limits);
+    return parse::parse_text(json_text, limits, calibration);
   } catch (const std::exception& e) {
     ParseResult r;
     r.errors.push_back({"", std::string("internal error while reading the spec: ") + e.what()});

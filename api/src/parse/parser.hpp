@@ -67,9 +67,12 @@ struct IntegratedFormula;  // motion.cpp
 /// The state of one parse: the reader with its errors, the Problem being
 /// built and what the whole-problem checks need later.
 struct ParseContext {
-  explicit ParseContext(const Limits& l) : limits(l) {}
+  ParseContext(const Limits& l, const Calibration& cal) : limits(l), calibration(cal) {}
 
   const Limits& limits;
+  const Calibration& calibration;  ///< what the cost is estimated with
+  /// The job's cost, estimated once by check_limits (it becomes ParsedJob::cost).
+  std::optional<CostEstimate> cost;
   SpecReader r;
   Problem p;
   std::string name = "job";

@@ -124,7 +124,7 @@ void get_result_file(Context& c, const httplib::Request& req, httplib::Response&
   }
   if (!file)
     return send_not_found(res, "job " + job->id + " has no result file named '" + name + "'");
-  const auto path = c.workers.results_dir(*job) / file->name;
+  const auto path = c.files.results_dir(*job) / file->name;
   struct stat st {};
   auto in = std::make_shared<std::ifstream>(path, std::ios::binary);
   if (::stat(path.c_str(), &st) != 0 || !*in ||

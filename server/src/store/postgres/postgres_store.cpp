@@ -13,6 +13,7 @@
 
 #include "clock.hpp"
 #include "migrate.hpp"
+#include "store/recovery.hpp"
 
 namespace hmpm::server::postgres {
 namespace {
@@ -304,12 +305,11 @@ ClaimState PostgresStore::requeue(const Claim& claim) {
   // The checkpoint stays: the next claim resumes from it.
   const Result r = exec(db,
                         "UPDATE jobs SET status = " + sql_name(JobStatus::accepted) +
-                            ", progress = 0, started = NULL, "
-                            "message = 'queued again: the server stopped while it ran', "
+                            ", progress = 0, started = NULL, message = $5, "
                             "updated = $4, attempts = greatest(attempts - 1, 0), "
                             "lease_expires_ms = 0 WHERE " +
                             claim_held,
-                        claim_params(claim).add(now));
+                        claim_params(claim).add(now).add(requeued_message));
   if (r.affected() != 1) return claim_state(db, claim);
   end_attempt(db, claim, "requeued", now);
   tx.commit();
@@ -401,27 +401,16 @@ RecoveryReport PostgresStore::recover(int max_attempts, double charge_after_s) {
   const std::string now = now_text();
   for (int i = 0; i < lapsed.rows(); ++i) {
     const std::string id = lapsed.text(i, 0);
-    const auto attempts = lapsed.integer(i, 1);
-    // Charged only when the attempt had run long enough to be the suspect
-    // (the rule of the SQLite store; store.hpp, recover).
-    const double ran_s = static_cast<double>(lapsed.integer(i, 3)) / 1000.0;
-    const auto charged = lapsed.integer(i, 2) + (ran_s >= charge_after_s ? 1 : 0);
-    std::string reason;
-    if (charged >= max_attempts) {
-      reason = "the server stopped " + std::to_string(charged) +
-               " times while this job ran (limit " + std::to_string(max_attempts) +
-               " attempts); not retried";
-    } else if (attempts >= std::int64_t{uncharged_start_factor} * max_attempts) {
-      reason = "this job was started " + std::to_string(attempts) +
-               " times and the server stopped every time (limit " +
-               std::to_string(uncharged_start_factor * max_attempts) + " starts); not retried";
-    }
+    const auto [charged, reason] =
+        decide_recovery({lapsed.integer(i, 1), lapsed.integer(i, 2),
+                         static_cast<double>(lapsed.integer(i, 3)) / 1000.0},
+                        max_attempts, charge_after_s);
     if (reason.empty()) {
       exec(db,
            "UPDATE jobs SET status = " + sql_name(JobStatus::accepted) +
-               ", progress = 0, started = NULL, updated = $1, charged = $3, "
-               "message = 'queued again: the server stopped while it ran' WHERE id = $2",
-           Params().add(now).add(id).add(charged));
+               ", progress = 0, started = NULL, updated = $1, charged = $3, message = $4 "
+               "WHERE id = $2",
+           Params().add(now).add(id).add(charged).add(requeued_message));
       report.requeued.push_back(id);
     } else {
       exec(db,

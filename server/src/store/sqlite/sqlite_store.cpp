@@ -12,6 +12,7 @@
 
 #include "clock.hpp"
 #include "migrate.hpp"
+#include "store/recovery.hpp"
 
 namespace hmpm::server::sqlite {
 namespace {
@@ -100,13 +101,6 @@ void insert_results(sqlite3* db, const std::string& id, const std::vector<Result
     s.bind(1, id).bind(2, f.name).bind(3, f.size).bind(4, f.sha256).bind(5, f.media_type);
     s.step();
   }
-}
-
-// "30 s", "1.5 s".
-std::string short_duration(double seconds) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%g s", seconds);
-  return text;
 }
 
 }  // namespace
@@ -385,12 +379,11 @@ ClaimState SqliteStore::requeue(const Claim& claim) {
   sqlite3* db = connection.get();
   WriteTransaction tx(db);
   Statement s(db, "UPDATE jobs SET status = " + sql_name(JobStatus::accepted) +
-                      ", progress = 0, started = NULL, "
-                      "message = 'queued again: the server stopped while it ran', updated = ?4, "
+                      ", progress = 0, started = NULL, message = ?5, updated = ?4, "
                       "attempts = max(attempts - 1, 0), lease_expires_ms = 0 WHERE " +
                       claim_held);
   bind_claim(s, claim);
-  s.bind(4, now_text());
+  s.bind(4, now_text()).bind(5, requeued_message);
   s.step();
   const ClaimState state = sqlite3_changes(db) == 1 ? ClaimState::held : claim_state(db, claim);
   tx.commit();
@@ -470,57 +463,36 @@ RecoveryReport SqliteStore::recover(int max_attempts, double charge_after_s) {
   auto connection = pool_.lease();
   sqlite3* db = connection.get();
   WriteTransaction tx(db);
-  struct Lapsed {
-    std::string id;
-    int attempts = 0;
-    int charged = 0;
-    double ran_s = 0.0;  ///< claim to last proof of life
-  };
-  std::vector<Lapsed> lapsed;
+  std::vector<std::pair<std::string, LapsedAttempt>> lapsed;
   {
     Statement s(db,
                 "SELECT id, attempts, charged, alive_ms - claimed_ms FROM jobs WHERE status = " +
                     sql_name(JobStatus::running) + " AND lease_expires_ms <= ?1 ORDER BY seq");
     s.bind(1, now_ms());
     while (s.step()) {
-      lapsed.push_back({s.text(0), static_cast<int>(s.integer(1)), static_cast<int>(s.integer(2)),
-                        static_cast<double>(s.integer(3)) / 1000.0});
+      lapsed.emplace_back(s.text(0), LapsedAttempt{s.integer(1), s.integer(2),
+                                                   static_cast<double>(s.integer(3)) / 1000.0});
     }
   }
   RecoveryReport report;
   const std::string now = now_text();
-  for (const Lapsed& job : lapsed) {
-    // Charged only when the attempt had run long enough to be the suspect;
-    // a job claimed just before an unrelated crash is not.
-    const int charged = job.charged + (job.ran_s >= charge_after_s ? 1 : 0);
-    std::string reason;
-    if (charged >= max_attempts) {
-      reason = "the server stopped " + std::to_string(charged) +
-               " times while this job ran (each time after at least " +
-               short_duration(charge_after_s) + " of its attempt; limit " +
-               std::to_string(max_attempts) + " attempts); not retried";
-    } else if (job.attempts >= uncharged_start_factor * max_attempts) {
-      reason = "this job was started " + std::to_string(job.attempts) +
-               " times and the server stopped every time, mostly within " +
-               short_duration(charge_after_s) + " of the start (limit " +
-               std::to_string(uncharged_start_factor * max_attempts) + " starts); not retried";
-    }
+  for (const auto& [id, attempt] : lapsed) {
+    const auto [charged, reason] = decide_recovery(attempt, max_attempts, charge_after_s);
     if (reason.empty()) {
-      Statement s(db,
-                  "UPDATE jobs SET status = " + sql_name(JobStatus::accepted) +
-                      ", progress = 0, started = NULL, updated = ?1, charged = ?3, "
-                      "message = 'queued again: the server stopped while it ran' WHERE id = ?2");
-      s.bind(1, now).bind(2, job.id).bind(3, static_cast<std::int64_t>(charged));
+      Statement s(db, "UPDATE jobs SET status = " + sql_name(JobStatus::accepted) +
+                          ", progress = 0, started = NULL, updated = ?1, charged = ?3, "
+                          "message = ?4 WHERE id = ?2");
+      s.bind(1, now).bind(2, id).bind(3, charged).bind(4, requeued_message);
       s.step();
-      report.requeued.push_back(job.id);
+      report.requeued.push_back(id);
     } else {
       Statement s(db, "UPDATE jobs SET status = " + sql_name(JobStatus::failed) +
                           ", message = ?1, failure_reason = ?1, finished = ?2, updated = ?2, "
                           "charged = ?4 WHERE id = ?3");
-      s.bind(1, reason).bind(2, now).bind(3, job.id).bind(4, static_cast<std::int64_t>(charged));
+      s.bind(1, reason).bind(2, now).bind(3, id).bind(4, charged);
       s.step();
-      clear_checkpoint(db, job.id);
-      report.failed.push_back(job.id);
+      clear_checkpoint(db, id);
+      report.failed.push_back(id);
     }
   }
   tx.commit();
