@@ -24,6 +24,9 @@ struct UpSystem::Solvers {
   Eigen::UmfPackLU<Eigen::SparseMatrix<double>> lu;
   Eigen::BiCGSTAB<Eigen::SparseMatrix<double>, Eigen::IncompleteLUT<double>> bicgstab;
   Eigen::VectorXd residual;  ///< check of the LDL^T solution
+  // CHOLMOD prints a failed LDL^T (which the LU then solves) on stderr:
+  // the outcome is reported by the return values instead.
+  Solvers() { ldlt.cholmod().print = 0; }
 };
 
 void UpSystem::SolversDeleter::operator()(Solvers* s) const {
