@@ -288,7 +288,7 @@ class QuasiStaticScheme final : public TimeScheme {
       }
     }
     system_.finish_pattern(sim_.problem_.time.implicit.linear_solver,
-                           sim_.problem_.time.implicit.linear_tolerance);
+                           sim_.problem_.time.implicit.linear_tolerance, Dim);
     rhs_.resize(unknowns_);
     ref_.resize(unknowns_);
     // Private sums of threads 1.. (zero between assemblies; no allocation
