@@ -19,6 +19,7 @@
 #include "digest.hpp"
 #include "job_log.hpp"
 #include "run_log.hpp"
+#include "run_tracker.hpp"
 
 namespace hmpm::server {
 namespace {
@@ -506,6 +507,7 @@ void WorkerPool::run_one(const JobRecord& job, Running& running) {
   JobStatus outcome = JobStatus::failed;
   std::string reason;
   hmpm::api::JobOutcome result;
+  RunTracker tracker;  // what the run reached, for the store
   if (!parsed.ok()) {
     reason = "the stored spec is no longer valid: " + describe(parsed.errors);
   } else {
@@ -521,6 +523,7 @@ void WorkerPool::run_one(const JobRecord& job, Running& running) {
     auto last_write = SteadyClock::now() - std::chrono::hours(1);
     ProgressLogPacer pacer;
     options.on_progress = [&](const hmpm::Progress& p) {
+      const RunProgress& reached = tracker.observe(p);
       const auto now = SteadyClock::now();
       if (pacer.due(p.fraction, now)) {
         append_run_log(dir, "progress " + std::to_string(whole(100.0 * p.fraction)) + " %: step " +
@@ -533,8 +536,7 @@ void WorkerPool::run_one(const JobRecord& job, Running& running) {
         return;
       last_write = now;
       try {
-        const ClaimState state =
-            store_.update_progress(claim, std::clamp(100.0 * p.fraction, 0.0, 100.0));
+        const ClaimState state = store_.record_progress(claim, reached);
         if (state != ClaimState::held) {  // dismissed through another path, or taken over: stop
           running.dismissed = state == ClaimState::dismissed;
           running.lost = state == ClaimState::lost;
@@ -642,7 +644,8 @@ void WorkerPool::run_one(const JobRecord& job, Running& running) {
   // The end of a job must reach the store, or it would stay running until a
   // restart: a failing write (disk full) is retried with backoff.
   const ClaimState state = with_retries(job.id, "finish", [&] {
-    return store_.finish(claim, JobEnd{outcome, message, reason, files, seconds});
+    return store_.finish(claim, JobEnd{outcome, message, reason, files, seconds,
+                                       tracker.finish(result.run.steps, result.run.end_time)});
   });
   if (state == ClaimState::lost) {  // taken over while finishing: not served, never will be
     claim_lost(claim, seconds);
