@@ -60,9 +60,9 @@ class PausedStore : public JobStore {
     return paused_;
   }
 
-  ClaimState update_progress(const Claim& claim, double percent) override {
+  ClaimState record_progress(const Claim& claim, const RunProgress& run) override {
     std::unique_lock<std::mutex> lock(mutex_);
-    if (resumed_) return inner_.update_progress(claim, percent);
+    if (resumed_) return inner_.record_progress(claim, run);
     paused_ = true;
     wake_.notify_all();
     wake_.wait(lock, [&] { return resumed_; });

@@ -40,6 +40,7 @@ std::vector<Route> route_table() {
       {Method::get, job + "/results", Access::token, get_manifest},
       {Method::get, job + "/results/(.+)", Access::token, get_result_file},
       {Method::get, job + "/events", Access::token, stream_events},
+      {Method::get, "/fields", Access::open, get_fields},
       {Method::get, "/ui(/.*)?", Access::open, get_ui},
       // OGC API – Processes (ogc.cpp); its jobs are the /jobs routes above.
       {Method::get,

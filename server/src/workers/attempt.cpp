@@ -14,6 +14,7 @@
 #include "digest.hpp"
 #include "job_log.hpp"
 #include "run_log.hpp"
+#include "run_tracker.hpp"
 #include "workers/pool.hpp"
 
 namespace hmpm::server {
@@ -176,6 +177,7 @@ class Attempt {
   const std::string& out_name() const { return out_name_; }
   /// The recorded checkpoint of this job, if any (relative to dir()).
   const std::string& checkpoint_file() const { return checkpoint_file_; }
+  RunTracker& tracker() { return tracker_; }
 
  private:
   // A claimed write was refused: stop, as for a cancel.
@@ -186,6 +188,7 @@ class Attempt {
   }
 
   void progress(const hmpm::Progress& p) {
+    const RunProgress& reached = tracker_.observe(p);
     const auto now = SteadyClock::now();
     if (pacer_.due(p.fraction, now)) {
       append_run_log(dir_, "progress " + std::to_string(whole(100.0 * p.fraction)) + " %: step " +
@@ -197,8 +200,7 @@ class Attempt {
       return;
     last_write_ = now;
     try {
-      const ClaimState state =
-          store_.update_progress(claim_, std::clamp(100.0 * p.fraction, 0.0, 100.0));
+      const ClaimState state = store_.record_progress(claim_, reached);
       if (state != ClaimState::held) stop_on(state);  // dismissed elsewhere, or taken over
     } catch (const std::exception& e) {
       log_line({{"event", "store_error"}, {"job", job_.id}, {"detail", e.what()}});
@@ -251,6 +253,7 @@ class Attempt {
   std::string checkpoint_file_;
   SteadyClock::time_point last_write_ = SteadyClock::now() - std::chrono::hours(1);
   ProgressLogPacer pacer_;
+  RunTracker tracker_;  ///< what the run reached, for the store
 };
 
 }  // namespace
@@ -380,7 +383,9 @@ void WorkerPool::run_one(const JobRecord& job, RunningJob& running) {
   // The end of a job must reach the store, or it would stay running until a
   // restart: a failing write (disk full) is retried with backoff.
   const ClaimState state = with_retries(job.id, "finish", [&] {
-    return store_.finish(claim, JobEnd{outcome, message, reason, files, seconds});
+    return store_.finish(claim, JobEnd{outcome, message, reason, files, seconds,
+                                       attempt.tracker().finish(result.run.steps,
+                                                                result.run.end_time)});
   });
   if (state == ClaimState::lost) {  // taken over while finishing: not served, never will be
     claim_lost(claim, seconds);

@@ -29,8 +29,10 @@ struct ServiceConfig {
   /// Result files; empty: <db dir>/results (SQLite only). With PostgreSQL it
   /// is shared by every server on the database, and not locked.
   std::filesystem::path data_dir;
-  int workers = 1;          ///< jobs run at the same time
-  int threads_per_job = 0;  ///< solver threads per job; <= 0: cores / workers
+  /// Jobs run at the same time. Two by default: a long job never holds the
+  /// queue, a short one submitted meanwhile runs beside it (issue 44).
+  int workers = 2;
+  int threads_per_job = 0;  ///< solver threads per job; <= 0: cores / workers (at least 1)
   std::string token;        ///< non-empty: Bearer token required (not on /health)
   long max_queue = 1000;    ///< accepted jobs before POST /jobs answers 503
   /// Per-job wall-clock limit, set-up included; <= 0: none.
