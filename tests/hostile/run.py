@@ -22,7 +22,10 @@ from pathlib import Path
 HERE = Path(__file__).resolve().parent
 REPO = HERE.parents[1]
 # Campaign (the issue number; 0: the first hardening issue) -> its items.
-ITEMS = {0: range(1, 12), 45: range(1, 11)}
+# Issue 45's items 2 (PostgreSQL submit lock), 5 (slow readers: the test
+# there does not reproduce the cut on loopback, so it is not counted), 7
+# and 8 are not delivered yet.
+ITEMS = {0: range(1, 12), 45: (1, 3, 4, 6, 9, 10)}
 SUMMED = ("faults", "bad_inputs", "requests", "lost")
 
 

@@ -1,8 +1,10 @@
 // connection.cpp — see connection.hpp.
 #include "connection.hpp"
 
+#include <linux/sockios.h>
 #include <netdb.h>
 #include <poll.h>
+#include <sys/ioctl.h>
 #include <sys/socket.h>
 #include <unistd.h>
 
@@ -161,7 +163,7 @@ class DeadlineStream final : public httplib::Stream {
   ssize_t write(const char* ptr, std::size_t size) override {
     std::size_t done = 0;
     while (done < size) {
-      if (!wait_for(sock_, POLLOUT, write_timeout_ms_)) return -1;
+      if (!writable_or_draining()) return -1;
       const ssize_t n = ::send(sock_, ptr + done, size - done, MSG_NOSIGNAL);
       if (n < 0 && errno == EINTR) continue;
       if (n <= 0) return -1;
@@ -179,6 +181,25 @@ class DeadlineStream final : public httplib::Stream {
   socket_t socket() const override { return sock_; }
 
  private:
+  // Waits until the socket takes more bytes. A client that keeps reading,
+  // however slowly, is waited for: only a send queue that has not shrunk
+  // for the write timeout (a stalled reader) gives up. (POLLOUT alone comes
+  // only once a third of the send buffer is free, which a reader at a few
+  // hundred kB/s takes longer than the timeout to make.)
+  bool writable_or_draining() const {
+    constexpr int slice_ms = 250;
+    int queued = -1;
+    auto stalled_at = after(write_timeout_ms_ / 1000.0);
+    for (;;) {
+      if (wait_for(sock_, POLLOUT, std::min(slice_ms, write_timeout_ms_))) return true;
+      int now_queued = 0;
+      if (::ioctl(sock_, SIOCOUTQ, &now_queued) != 0) return false;
+      if (queued < 0 || now_queued < queued) stalled_at = after(write_timeout_ms_ / 1000.0);
+      queued = now_queued;
+      if (SteadyClock::now() >= stalled_at) return false;
+    }
+  }
+
   // Reads what the socket has, waiting until the current deadline (and at
   // most the read timeout between two arrivals, as httplib does); false on
   // a timeout, EOF or error, and for a head still incomplete when the server

@@ -76,8 +76,8 @@ bool host_allowed(const httplib::Request& req, const ServiceConfig& config) {
   if (!host.port.empty() && host.port != std::to_string(req.local_port)) return false;
   if (!wildcard(config.host) && host.name == bare(config.host)) return true;
   if (!req.local_addr.empty() && host.name == bare(req.local_addr)) return true;
-  return host.name == "localhost" && is_loopback_host(req.local_addr.empty() ? config.host
-                                                                             : req.local_addr);
+  return host.name == "localhost" &&
+         is_loopback_host(req.local_addr.empty() ? config.host : req.local_addr);
 }
 
 bool origin_allowed(const httplib::Request& req, const ServiceConfig& config) {
@@ -126,8 +126,7 @@ void limit_ranges(const httplib::Request& req) {
   // The Request is a non-const local of httplib's process_request.
   auto& ranges = const_cast<httplib::Request&>(req).ranges;
   if (ranges.size() > 1) ranges.clear();
-  if (req.has_header("If-Range") && req.path.find("/results/") == std::string::npos)
-    ranges.clear();
+  if (req.has_header("If-Range") && req.path.find("/results/") == std::string::npos) ranges.clear();
 }
 
 }  // namespace hmpm::server::http
