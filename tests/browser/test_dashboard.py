@@ -85,6 +85,8 @@ class Dashboard(unittest.TestCase):
     @classmethod
     def call(cls, method, path, body=None):
         req = urllib.request.Request(cls.service.url + path, method=method, data=body)
+        if body:  # the server takes JSON bodies only (415 otherwise)
+            req.add_header("Content-Type", "application/json")
         if TOKEN:
             req.add_header("Authorization", f"Bearer {TOKEN}")
         with urllib.request.urlopen(req, timeout=30) as resp:

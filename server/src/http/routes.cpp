@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "connection.hpp"
+#include "exposure.hpp"
 #include "handlers.hpp"
 #include "problem.hpp"
 
@@ -158,6 +159,7 @@ void Router::register_route(httplib::Server& server, const Compiled& c) const {
           if (guarded && !auth_.authorized(req)) return auth_.refuse(res);
           if (!query_accepted(route, req, res)) return;
           f(context_, req, res);
+          bound_compression(req, res);
         });
     return;
   }
@@ -196,6 +198,7 @@ void Router::register_route(httplib::Server& server, const Compiled& c) const {
                         if (guarded && !auth_.authorized(req)) return auth_.refuse(res);
                         if (!query_accepted(route, req, res)) return;
                         f(context_, req, res, body);
+                        bound_compression(req, res);
                       });
 }
 

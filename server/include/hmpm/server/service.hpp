@@ -56,6 +56,12 @@ struct ServiceConfig {
   double body_timeout_s = 60.0;       ///< a request's body must arrive within this
   double event_stream_max_s = 300.0;  ///< an event stream ends after this; the client reconnects
   bool allow_no_token = false;  ///< a non-loopback --host without a token starts (with a warning)
+  /// Host header values accepted besides the listening address (NAME, any
+  /// port, or NAME:PORT): the names clients and proxies reach the server by.
+  std::vector<std::string> allowed_hosts;
+  /// Origins (scheme://host[:port]) whose pages may write (POST, DELETE...)
+  /// and get CORS headers; the server's own origin needs no entry.
+  std::vector<std::string> allowed_origins;
   double progress_interval_s = 1.0;    ///< how often a running job's progress is stored
   double heartbeat_interval_s = 10.0;  ///< SSE comment line when nothing else was sent
   double lease_s = 30.0;  ///< a running job's claim lapses this long after its last renewal
