@@ -1,8 +1,8 @@
 // fields.cpp — GET /fields: the output fields with their kinds and units,
 // from the solver's table (solver/include/hmpm/fields.hpp). The dashboard
 // and the Python client label their plots from it instead of keeping copies.
-#include "handlers.hpp"
 #include "hmpm/fields.hpp"
+#include "handlers.hpp"
 #include "problem.hpp"
 
 namespace hmpm::server::http {

@@ -383,9 +383,9 @@ void WorkerPool::run_one(const JobRecord& job, RunningJob& running) {
   // The end of a job must reach the store, or it would stay running until a
   // restart: a failing write (disk full) is retried with backoff.
   const ClaimState state = with_retries(job.id, "finish", [&] {
-    return store_.finish(claim, JobEnd{outcome, message, reason, files, seconds,
-                                       attempt.tracker().finish(result.run.steps,
-                                                                result.run.end_time)});
+    return store_.finish(claim,
+                         JobEnd{outcome, message, reason, files, seconds,
+                                attempt.tracker().finish(result.run.steps, result.run.end_time)});
   });
   if (state == ClaimState::lost) {  // taken over while finishing: not served, never will be
     claim_lost(claim, seconds);

@@ -333,7 +333,8 @@ ClaimState PostgresStore::requeue(const Claim& claim) {
   // The checkpoint stays: the next claim resumes from it.
   const Result r = exec(db,
                         "UPDATE jobs SET status = " + sql_name(JobStatus::accepted) +
-                            ", progress = 0, " + no_run + "started = NULL, message = $5, "
+                            ", progress = 0, " + no_run +
+                            "started = NULL, message = $5, "
                             "updated = $4, attempts = greatest(attempts - 1, 0), "
                             "lease_expires_ms = 0 WHERE " +
                             claim_held,

@@ -405,7 +405,8 @@ ClaimState SqliteStore::requeue(const Claim& claim) {
   sqlite3* db = connection.get();
   WriteTransaction tx(db);
   Statement s(db, "UPDATE jobs SET status = " + sql_name(JobStatus::accepted) + ", progress = 0, " +
-                      no_run + "started = NULL, message = ?5, updated = ?4, "
+                      no_run +
+                      "started = NULL, message = ?5, updated = ?4, "
                       "attempts = max(attempts - 1, 0), lease_expires_ms = 0 WHERE " +
                       claim_held);
   bind_claim(s, claim);
