@@ -31,6 +31,7 @@ json base_spec() {
 
 std::vector<std::string> paths(const std::vector<hmpm::api::SpecError>& errors) {
   std::vector<std::string> out;
+  out.reserve(errors.size());
   for (const auto& e : errors) out.push_back(e.path);
   return out;
 }

@@ -123,7 +123,9 @@ TEST(RandomField, SeparableIn2DWithAxisLengths) {
   for (int j = 0; j <= 4; ++j)
     for (int i = 0; i <= 8; ++i) pts.push_back({0.5 * i, 0.25 * j, 0.0});
   const auto v = over_seeds(f, 2, pts, true);
-  auto at = [&](int i, int j) { return v[static_cast<std::size_t>(j * 9 + i)]; };
+  auto at = [&](int i, int j) {
+    return v[(static_cast<std::size_t>(j) * 9) + static_cast<std::size_t>(i)];
+  };
   expect_correlation(at(0, 0), at(4, 0), std::exp(-1.0), "x lag 2 m (theta_x 4 m)");
   expect_correlation(at(0, 0), at(0, 2), std::exp(-1.0), "y lag 0.5 m (theta_y 1 m)");
   expect_correlation(at(0, 0), at(4, 2), std::exp(-2.0), "diagonal");

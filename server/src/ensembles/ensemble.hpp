@@ -36,6 +36,7 @@ struct Vary {
   std::vector<json> values;  ///< a sweep: sample k takes values[k]
 };
 
+// NOLINTNEXTLINE(bugprone-exception-escape): json's defaulted members (never throw for null)
 struct Request {
   json spec;
   int samples = 0;

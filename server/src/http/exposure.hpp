@@ -46,6 +46,6 @@ void limit_ranges(const httplib::Request& req);
 /// it (or sent as they are): "br" is taken out of the request's
 /// Accept-Encoding, which httplib reads when it writes the answer.
 void bound_compression(const httplib::Request& req, const httplib::Response& res);
-constexpr std::size_t brotli_max_bytes = 32 * 1024;
+constexpr std::size_t brotli_max_bytes = std::size_t{32} * 1024;
 
 }  // namespace hmpm::server::http
