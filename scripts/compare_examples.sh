@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Runs every example with two builds of the `hmpm` command and compares
-# series.json and reactions.json byte for byte (the rooms issue's "identical results" check).
+# series.json, reactions.json and consolidation.json byte for byte (the rooms issue's "identical results" check).
 #   bash scripts/compare_examples.sh OLD_BIN_DIR NEW_BIN_DIR [THREADS...]
 # OLD_BIN_DIR/NEW_BIN_DIR hold an `hmpm` executable (e.g. build/bin).
 # Exit 0 when every example's series.json (and summary.json's "steps")
@@ -23,7 +23,7 @@ for spec in examples/*.json; do
     # Every history both builds wrote (an example may ask for reactions
     # only, as the footing does).
     compared=0
-    for file in series.json reactions.json; do
+    for file in series.json reactions.json consolidation.json; do
       [ -f "$work/old-$name-$t/$file" ] || continue
       compared=1
       a=$(sha256sum < "$work/old-$name-$t/$file" | cut -c1-16)

@@ -7,6 +7,8 @@ set -euo pipefail
 packages=(
   build-essential cmake ninja-build pkg-config git curl   # ninja: parallel builds (scripts/build.sh)
   libeigen3-dev            # solver: linear algebra (header only)
+  libsuitesparse-dev       # solver: CHOLMOD and UMFPACK, the quasi-static u-p solves (linear/)
+  libmetis-dev             # bench: METIS orderings compared in docs/performance.md (CHOLMOD links libmetis5)
   nlohmann-json3-dev       # api: JSON parsing
   libmuparser-dev          # api: expressions in job specs
   libsqlite3-dev           # server: job store

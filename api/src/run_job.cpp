@@ -12,7 +12,7 @@
 #include <stdexcept>
 
 #include "hmpm/api/job.hpp"
-#include "writers.hpp"
+#include "results/writers.hpp"
 
 namespace hmpm::api {
 

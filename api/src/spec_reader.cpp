@@ -124,12 +124,23 @@ class DomBuilder {
 
 bool parse_json_guarded(std::string_view text, int max_depth, json& out,
                         std::vector<SpecError>& errors) {
+  return parse_json_guarded(text, max_depth, out, errors, TopArrayLimit{});
+}
+
+bool parse_json_guarded(std::string_view text, int max_depth, json& out,
+                        std::vector<SpecError>& errors, const TopArrayLimit& limit) {
   // Pre-scan the nesting outside strings, so a hostile document costs O(n)
   // and no stack before anything is built; nothing in a spec needs more
-  // than a handful of levels.
+  // than a handful of levels. It also counts the elements of the top-level
+  // array `limit.key` (its commas at depth 2).
   int depth = 0;
   bool in_string = false, escaped = false;
   std::size_t line = 1;
+  std::size_t string_start = 0;
+  bool last_string_is_key = false;  // the last string closed at depth 1 is limit.key
+  bool key_pending = false;         // ... and only its ':' followed it
+  bool counting = false;            // inside the limited array
+  std::size_t elements = 0;
   for (std::size_t i = 0; i < text.size(); ++i) {
     const char c = text[i];
     if (c == '\n') ++line;
@@ -138,13 +149,38 @@ bool parse_json_guarded(std::string_view text, int max_depth, json& out,
         escaped = false;
       else if (c == '\\')
         escaped = true;
-      else if (c == '"')
+      else if (c == '"') {
         in_string = false;
+        last_string_is_key = depth == 1 && !limit.key.empty() &&
+                             text.substr(string_start, i - string_start) == limit.key;
+      }
       continue;
     }
-    if (c == '"')
+    if (c == ' ' || c == '\t' || c == '\n' || c == '\r') continue;
+    if (c == ':') {
+      key_pending = last_string_is_key;
+      last_string_is_key = false;
+      continue;
+    }
+    const bool opens_array = c == '[' && key_pending && depth == 1;
+    key_pending = last_string_is_key = false;
+    if (opens_array) {
+      counting = true;
+      elements = 0;
+    }
+    if (counting && depth == 2 && (c == ',' || (elements == 0 && c != ']'))) {
+      if (++elements > limit.max_elements) {
+        errors.push_back({"/" + std::string(limit.key),
+                          "has more than " + std::to_string(limit.max_elements) +
+                              " elements; the limit is " + std::to_string(limit.max_elements) +
+                              std::string(limit.advice)});
+        return false;
+      }
+    }
+    if (c == '"') {
       in_string = true;
-    else if (c == '[' || c == '{') {
+      string_start = i + 1;
+    } else if (c == '[' || c == '{') {
       if (++depth > max_depth) {
         errors.push_back({"", "not accepted: brackets nested deeper than " +
                                   std::to_string(max_depth) + " levels (byte " +
@@ -153,6 +189,7 @@ bool parse_json_guarded(std::string_view text, int max_depth, json& out,
       }
     } else if (c == ']' || c == '}') {
       depth = std::max(depth - 1, 0);
+      if (depth == 1) counting = false;
     }
   }
   DomBuilder builder(out, errors);
@@ -328,10 +365,16 @@ std::optional<std::string> SpecReader::string(const json& j, const std::string& 
     return std::nullopt;
   }
   const auto& s = j.get_ref<const std::string&>();
+  // Characters, not bytes (UTF-8, which the JSON parser has checked): every
+  // byte but a continuation byte starts one.
   if (s.size() > max_length) {
-    error(path, "is " + std::to_string(s.size()) + " characters long; at most " +
-                    std::to_string(max_length));
-    return std::nullopt;
+    const auto characters = static_cast<std::size_t>(std::count_if(
+        s.begin(), s.end(), [](char b) { return (static_cast<unsigned char>(b) & 0xC0) != 0x80; }));
+    if (characters > max_length) {
+      error(path, "is " + std::to_string(characters) + " characters long; at most " +
+                      std::to_string(max_length));
+      return std::nullopt;
+    }
   }
   return s;
 }

@@ -30,8 +30,20 @@ std::string escape_pointer_token(std::string_view token);
 std::string child_pointer(const std::string& parent, std::string_view token);
 std::string child_pointer(const std::string& parent, std::size_t index);
 
-/// Parses `text` into `out`. Refuses nesting deeper than `max_depth` before
-/// building anything. On failure returns false and appends an error at "".
+/// A top-level array the pre-scan of parse_json_guarded counts: more than
+/// `max_elements` in the array under `key` is refused before anything is
+/// built (building a 16 MB document's values costs seconds).
+struct TopArrayLimit {
+  std::string_view key;
+  std::size_t max_elements = 0;
+  std::string_view advice;  ///< appended to the error
+};
+
+/// Parses `text` into `out`. Refuses nesting deeper than `max_depth`, and
+/// a top-level array beyond `limit` (error at "/KEY"), before building
+/// anything. On failure returns false and appends an error.
+bool parse_json_guarded(std::string_view text, int max_depth, json& out,
+                        std::vector<SpecError>& errors, const TopArrayLimit& limit);
 bool parse_json_guarded(std::string_view text, int max_depth, json& out,
                         std::vector<SpecError>& errors);
 

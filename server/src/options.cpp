@@ -78,7 +78,8 @@ std::string usage() {
          "                   [--checkpoint-interval S] [--lease-seconds S]\n"
          "                   [--max-connections N] [--request-head-timeout S]\n"
          "                   [--request-body-timeout S] [--event-stream-max-seconds S]\n"
-         "                   [--allow-no-token]\n"
+         "                   [--allow-no-token] [--allowed-host NAME[:PORT]]...\n"
+         "                   [--allowed-origin ORIGIN]...\n"
          "  --host H              address to listen on (default 127.0.0.1); any address but\n"
          "                        loopback needs a token (or --allow-no-token)\n"
          "  --port P              port; 0 picks a free one (default 8080)\n"
@@ -88,12 +89,18 @@ std::string usage() {
          "                        share; then --data-dir is required (one folder all of them\n"
          "                        read and write)\n"
          "  --data-dir DIR        result files (default with SQLite: <db dir>/results)\n"
-         "  --workers N           jobs run at the same time (default 1)\n"
+         "  --workers N           jobs run at the same time (default 2: a short job runs\n"
+         "                        beside a long one; workers x threads = cores)\n"
          "  --threads-per-job N   solver threads per job (default: cores / workers)\n"
          "  --token-file F        require 'Authorization: Bearer T', T the first line of F\n"
          "  --token T             the same with T given here (visible in the process list;\n"
          "                        prefer --token-file or $HMPM_TOKEN, the default)\n"
          "  --allow-no-token      start on a non-loopback --host without a token (warns)\n"
+         "  --allowed-host NAME[:PORT]  a Host header accepted besides the listening address\n"
+         "                        (and localhost on loopback); repeatable. Others get 421\n"
+         "  --allowed-origin ORIGIN  a web origin (http(s)://HOST[:PORT]) whose pages may\n"
+         "                        write (POST, DELETE) and get CORS headers; repeatable.\n"
+         "                        Other origins' writes get 403\n"
          "  --max-queue N         queued jobs before POST /jobs answers 503 (default 1000)\n"
          "  --job-wall-time S     fail a job running (set-up included) longer than S seconds;\n"
          "                        0: none (default 86400)\n"
@@ -228,6 +235,21 @@ ParsedOptions parse_options(const std::vector<std::string>& args, const char* en
       {"--request-head-timeout", positive_seconds(config.head_timeout_s)},
       {"--request-body-timeout", positive_seconds(config.body_timeout_s)},
       {"--event-stream-max-seconds", positive_seconds(config.event_stream_max_s)},
+      {"--allowed-host",
+       [&](const std::string& v) {
+         const bool ok = !v.empty() && v.find_first_of(" \t/,@") == std::string::npos;
+         if (ok) config.allowed_hosts.push_back(v);
+         return ok ? std::string() : std::string("must be a host name, NAME or NAME:PORT");
+       }},
+      {"--allowed-origin",
+       [&](const std::string& v) {
+         const bool ok = (v.rfind("http://", 0) == 0 || v.rfind("https://", 0) == 0) &&
+                         v.find('/', v.find("://") + 3) == std::string::npos &&
+                         v.size() > v.find("://") + 3;
+         if (ok) config.allowed_origins.push_back(v);
+         return ok ? std::string()
+                   : std::string("must be an origin, http(s)://HOST[:PORT] without a path");
+       }},
   };
   // Flags without a value.
   const std::map<std::string, std::function<void()>> switches{

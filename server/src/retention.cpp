@@ -43,24 +43,23 @@ void remove_orphans(JobStore& store, const std::filesystem::path& data_dir,
 
 }  // namespace
 
-std::vector<std::string> purge_expired(JobStore& store, const std::filesystem::path& data_dir,
-                                       int retain_days, std::chrono::system_clock::time_point now) {
+std::vector<std::string> purge_expired(JobStore& store, const JobFiles& files, int retain_days,
+                                       std::chrono::system_clock::time_point now) {
   if (retain_days <= 0) return {};
   const auto cutoff = now - std::chrono::hours(24) * retain_days;
   // The rows go first: once a job is unknown nothing serves its files, and a
   // folder left by a crash in between holds no job anyone can ask for.
   std::vector<std::string> ids = store.purge_ended(cutoff);
   for (const std::string& id : ids) {
-    std::error_code ec;
-    std::filesystem::remove_all(data_dir / id, ec);
+    const bool removed = files.remove(id);
     log_line({{"event", "purge"},
               {"job", id},
               {"ended_before", format_rfc3339(cutoff)},
-              {"files_removed", !ec}});
+              {"files_removed", removed}});
   }
   // file_time_type's clock is not system_clock: carry the age over.
   const auto age = std::chrono::system_clock::now() - cutoff;
-  remove_orphans(store, data_dir,
+  remove_orphans(store, files.data_dir(),
                  std::filesystem::file_time_type::clock::now() -
                      std::chrono::duration_cast<std::filesystem::file_time_type::duration>(age));
   return ids;

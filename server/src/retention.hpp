@@ -14,13 +14,14 @@
 #include <vector>
 
 #include "hmpm/server/store.hpp"
+#include "job_files.hpp"
 
 namespace hmpm::server {
 
 /// Purges the jobs that ended before `now` - `retain_days` days from `store`
-/// and removes their folders under `data_dir`; logs one line per job.
+/// and removes their folders (`files`); logs one line per job.
 /// Returns the purged ids. `retain_days` <= 0: purges nothing.
-std::vector<std::string> purge_expired(JobStore& store, const std::filesystem::path& data_dir,
-                                       int retain_days, std::chrono::system_clock::time_point now);
+std::vector<std::string> purge_expired(JobStore& store, const JobFiles& files, int retain_days,
+                                       std::chrono::system_clock::time_point now);
 
 }  // namespace hmpm::server

@@ -7,7 +7,7 @@
 // servers share the database and the data folder, and the claims keep them
 // apart. Each process is one store instance (`instance_id`): its claims carry
 // that id, its heartbeat renews their leases and takes over lapsed ones
-// (worker_pool.hpp). Requests are served by http/.
+// (workers/pool.hpp). Requests are served by http/.
 #include <sys/socket.h>
 
 #include <chrono>
@@ -30,7 +30,7 @@
 #include "process_lock.hpp"
 #include "retention.hpp"
 #include "store/postgres/connection.hpp"
-#include "worker_pool.hpp"
+#include "workers/pool.hpp"
 
 namespace hmpm::server {
 namespace {
@@ -109,7 +109,7 @@ struct Service::Impl {
         store(open_store(config)),
         workers(*store, metrics, worker_settings(config, limits, instance_id)),
         validation(validation_turns(), std::max(2, config.http_threads / 4), validation_wait_s),
-        context{config, limits, *store, metrics, workers, stopping, validation},
+        context{config, limits, *store, metrics, workers, workers.files(), stopping, validation},
         auth(config.token),
         router(http::route_table(), context, auth),
         server(connection_limits(config)) {
@@ -165,7 +165,7 @@ struct Service::Impl {
 
   void purge_now(std::chrono::system_clock::time_point now) {
     try {
-      hmpm::server::purge_expired(*store, config.data_dir, config.retain_days, now);
+      hmpm::server::purge_expired(*store, workers.files(), config.retain_days, now);
     } catch (const std::exception& e) {  // a failing database: try again next time
       log_line({{"event", "store_error"}, {"during", "purge"}, {"detail", e.what()}});
     }
@@ -269,7 +269,7 @@ void Service::stop() {
 }
 
 std::vector<std::string> Service::purge_expired(std::chrono::system_clock::time_point now) {
-  return hmpm::server::purge_expired(*impl_->store, impl_->config.data_dir,
+  return hmpm::server::purge_expired(*impl_->store, impl_->workers.files(),
                                      impl_->config.retain_days, now);
 }
 

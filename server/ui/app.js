@@ -4,6 +4,7 @@
 // called when the route changes (to stop polling and event streams).
 
 import { get_json, set_token, token } from '/ui/api.js';
+import { set_field_units } from '/ui/dom.js';
 import * as job_list from '/ui/jobs.js';
 import * as job_page from '/ui/job.js';
 import * as submit_page from '/ui/submit.js';
@@ -57,8 +58,20 @@ function setup_token() {
   });
 }
 
+// The fields' units (GET /fields, no token) label every plot; a page drawn
+// without them would show bare field names, so the first route waits (a
+// failure only leaves the units out).
+async function load_field_units() {
+  try {
+    set_field_units(await get_json('/fields'));
+  } catch (err) {
+    console.warn('GET /fields failed: plots carry no units', err);
+  }
+}
+
 setup_token();
 window.addEventListener('hashchange', route);
+await load_field_units();
 route();
 check_health();
 setInterval(check_health, 15000);

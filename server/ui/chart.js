@@ -44,21 +44,26 @@ function extent(values) {
 }
 
 // Line chart of `lines` = [{label, x: number[], y: number[]}] into an SVG
-// element; `markers` draws a dot at every point (profiles).
-export function line_chart(lines, { x_label = '', y_label = '', markers = false, width = 760, height = 360 } = {}) {
+// element; `markers` draws a dot at every point (profiles); `y_down` makes
+// y grow downward (depth); `x_log` puts x on a log scale (positive values
+// only, decades as ticks).
+export function line_chart(lines, { x_label = '', y_label = '', markers = false, y_down = false, x_log = false, width = 760, height = 360 } = {}) {
   const m = { left: 72, right: 16, top: 14, bottom: 46 };
   const w = width - m.left - m.right;
   const hgt = height - m.top - m.bottom;
+  const fx = x_log ? (v) => (v > 0 ? Math.log10(v) : NaN) : (v) => v;
+  lines = lines.map((l) => ({ ...l, x: l.x.map(fx) }));
   const [x0, x1] = extent(lines.flatMap((l) => l.x));
   const [y0, y1] = extent(lines.flatMap((l) => l.y));
   const sx = (v) => m.left + ((v - x0) / (x1 - x0)) * w;
-  const sy = (v) => m.top + hgt - ((v - y0) / (y1 - y0)) * hgt;
-  const root = svg('svg', { viewBox: `0 0 ${width} ${height}`, class: 'chart', role: 'img', 'aria-label': `${y_label} against ${x_label}` });
+  const sy = y_down ? (v) => m.top + ((v - y0) / (y1 - y0)) * hgt : (v) => m.top + hgt - ((v - y0) / (y1 - y0)) * hgt;
+  const x_ticks = x_log ? ticks(Math.ceil(x0), Math.floor(x1), Math.max(1, Math.floor(x1) - Math.ceil(x0))).filter(Number.isInteger) : ticks(x0, x1);
+  const root = svg('svg', { viewBox: `0 0 ${width} ${height}`, class: 'chart', role: 'img', 'aria-label': `${y_label} against ${x_label}`, 'data-y-down': y_down ? 'true' : 'false' });
   const grid = svg('g', { class: 'grid' });
   const axes = svg('g', { class: 'axis' });
-  for (const t of ticks(x0, x1)) {
+  for (const t of x_ticks) {
     grid.append(svg('line', { x1: sx(t), x2: sx(t), y1: m.top, y2: m.top + hgt }));
-    axes.append(svg('text', { x: sx(t), y: m.top + hgt + 16, 'text-anchor': 'middle' }, num(t)));
+    axes.append(svg('text', { x: sx(t), y: m.top + hgt + 16, 'text-anchor': 'middle' }, num(x_log ? 10 ** t : t)));
   }
   for (const t of ticks(y0, y1, 5)) {
     grid.append(svg('line', { x1: m.left, x2: m.left + w, y1: sy(t), y2: sy(t) }));
@@ -70,7 +75,7 @@ export function line_chart(lines, { x_label = '', y_label = '', markers = false,
   root.append(grid, axes);
   const plot = svg('g', { class: 'lines' });
   lines.forEach((line, i) => {
-    const colour = PALETTE[i % PALETTE.length];
+    const colour = line.colour || PALETTE[i % PALETTE.length];
     let d = '';
     let pen = false;
     for (let k = 0; k < line.x.length; ++k) {
@@ -78,13 +83,29 @@ export function line_chart(lines, { x_label = '', y_label = '', markers = false,
       if (ok) d += `${pen ? 'L' : 'M'}${sx(line.x[k]).toFixed(2)},${sy(line.y[k]).toFixed(2)}`;
       pen = ok;
     }
-    const path = svg('path', { d, fill: 'none', stroke: colour, 'stroke-width': 1.8, 'data-points': line.x.length });
+    const path = svg('path', { d, fill: 'none', stroke: colour, 'stroke-width': 1.8, 'data-points': line.x.length, 'data-label': line.label });
     path.append(svg('title', {}, line.label));
     plot.append(path);
-    if (markers) for (let k = 0; k < line.x.length; ++k) plot.append(svg('circle', { cx: sx(line.x[k]), cy: sy(line.y[k]), r: 2.5, fill: colour }));
+    if (markers) for (let k = 0; k < line.x.length; ++k) if (Number.isFinite(line.x[k]) && Number.isFinite(line.y[k])) plot.append(svg('circle', { cx: sx(line.x[k]), cy: sy(line.y[k]), r: 2.5, fill: colour }));
   });
   root.append(plot);
   return root;
+}
+
+// A legend of `lines` (HTML: a swatch and the label per line).
+export function legend(lines) {
+  const box = document.createElement('div');
+  box.className = 'legend';
+  lines.forEach((line, i) => {
+    const item = document.createElement('span');
+    item.className = 'legend-item';
+    const swatch = document.createElement('span');
+    swatch.className = 'swatch';
+    swatch.style.background = line.colour || PALETTE[i % PALETTE.length];
+    item.append(swatch, line.label);
+    box.append(item);
+  });
+  return box;
 }
 
 // Viridis-like colour map, t in [0, 1] -> "rgb(...)".

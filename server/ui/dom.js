@@ -18,16 +18,38 @@ export function h(tag, attrs = {}, ...children) {
   return el;
 }
 
-// SI units of the output fields (CONTRACT.md), for axis and colour-bar labels.
-const UNITS = {
-  position: 'm', displacement: 'm', velocity: 'm/s', pore_pressure: 'Pa', darcy_velocity: 'm/s',
-  effective_stress: 'Pa', total_stress: 'Pa', volume: 'm³', strain: '', porosity: '', material: '',
-};
+// Units for axis and colour-bar labels. The output fields' units come from
+// the server (GET /fields, the solver's table; app.js loads them before the
+// first page); the snapshots' extra arrays, which are not output fields, are
+// named here. A dimensionless unit ('-') is not shown.
+const units = { volume: 'm³', material: '' };
+
+// Takes GET /fields: {fields: [{name, kind, unit}, ...]}.
+export function set_field_units(doc) {
+  for (const f of doc?.fields || []) if (typeof f.name === 'string' && typeof f.unit === 'string') units[f.name] = f.unit === '-' ? '' : f.unit;
+}
 
 // "pore pressure (Pa)", "velocity x (m/s)".
 export function field_label(name, component = '') {
-  const unit = UNITS[name];
+  const unit = units[name];
   return `${name.replace(/_/g, ' ')}${component ? ` ${component}` : ''}${unit ? ` (${unit})` : ''}`;
+}
+
+// The unit that reads best for times up to `span` seconds (as the Python
+// client's units.time_unit): s below 2 min, min below 2 h, h below 2 days,
+// days below a year, then years. Returns [seconds per unit, name].
+export function time_unit(span) {
+  const s = Math.abs(Number(span)) || 0;
+  const rows = [[1, 's', 0], [60, 'min', 120], [3600, 'h', 7200], [86400, 'days', 172800], [31557600, 'years', 31557600]];
+  let best = rows[0];
+  for (const row of rows) if (s >= row[2]) best = row;
+  return [best[0], best[1]];
+}
+
+// "10 days", "1.5 years", "30 s": `t` in the unit that reads best for it.
+export function format_time(t) {
+  const [scale, name] = time_unit(t);
+  return `${num(t / scale)} ${name}`;
 }
 
 export const STATUSES = ['accepted', 'running', 'successful', 'failed', 'dismissed'];

@@ -4,8 +4,9 @@
 // and delete behind a confirmation.
 
 import { download, get_json, get_text, read_events, request, token } from '/ui/api.js';
-import { bytes, confirm_dialog, duration, h, is_active, job_id, local_time, notice, num, pretty_json, progress_bar, status_badge } from '/ui/dom.js';
+import { bytes, confirm_dialog, duration, h, is_active, job_id, local_time, notice, format_time, num, pretty_json, progress_bar, status_badge } from '/ui/dom.js';
 import { series_panel } from '/ui/series.js';
+import { consolidation_panel, profiles_panel } from '/ui/profiles.js';
 import { snapshot_panel } from '/ui/snapshot.js';
 import { DRAFT_KEY, expected_seconds } from '/ui/submit.js';
 
@@ -36,6 +37,11 @@ export function render(main, id) {
   // shown once the job has results
   const series_card = h('section', { class: 'card', hidden: true }, h('div', { class: 'card-head' }, h('h3', {}, 'Series')), series_body);
   const snapshot_card = h('section', { class: 'card', hidden: true }, h('div', { class: 'card-head' }, h('h3', {}, 'Snapshot')), snapshot_body);
+  // shown when the job wrote profiles.json / consolidation.json
+  const profiles_body = h('div', { id: 'profiles' });
+  const profiles_card = h('section', { class: 'card', hidden: true, id: 'profiles-card' }, h('div', { class: 'card-head' }, h('h3', {}, 'Profiles')), profiles_body);
+  const consolidation_body = h('div', { id: 'consolidation' });
+  const consolidation_card = h('section', { class: 'card', hidden: true, id: 'consolidation-card' }, h('div', { class: 'card-head' }, h('h3', {}, 'Consolidation')), consolidation_body);
 
   main.append(
     h('div', { class: 'crumbs' }, h('a', { href: '#/jobs' }, '← All jobs')),
@@ -43,6 +49,8 @@ export function render(main, id) {
     action_message,
     warnings,
     series_card,
+    profiles_card,
+    consolidation_card,
     snapshot_card,
     h('div', { class: 'two-col' },
       h('section', { class: 'card' }, h('div', { class: 'card-head' }, h('h3', {}, 'Result files')), results_body),
@@ -60,6 +68,26 @@ export function render(main, id) {
 
   function fact(label, value) {
     return h('div', { class: 'fact' }, h('div', { class: 'fact-label' }, label), h('div', { class: 'fact-value' }, value));
+  }
+
+  // Steps and time step: what ran (the status document's `run`, once the
+  // job has run) or, before, the estimate (`cost`), labelled as such.
+  function run_facts(doc) {
+    const run = doc.run;
+    const cost = doc.cost || {};
+    if (run && run.steps > 0) {
+      const range = run.dt_max > 0 ? (num(run.dt_min) === num(run.dt_max) ? `${num(run.dt_min)} s` : `${num(run.dt_min)} – ${num(run.dt_max)} s`) : '—';
+      return [
+        fact(is_active(doc.status) ? 'Steps so far' : 'Steps run', h('span', { id: 'job-steps', 'data-source': 'run' }, String(run.steps))),
+        fact('Time step', h('span', { id: 'job-dt', 'data-source': 'run' }, range)),
+        fact('Simulated', h('span', { id: 'job-simulated' }, `${format_time(run.simulated_time)} of ${format_time(run.end_time)}`)),
+      ];
+    }
+    return [
+      fact('Steps (estimate)', h('span', { id: 'job-steps', 'data-source': 'estimate' }, cost.steps ?? '—')),
+      fact('First time step', h('span', { id: 'job-dt', 'data-source': 'estimate' }, cost.dt !== undefined ? `${num(cost.dt)} s` : '—')),
+      ...(doc.queue_position ? [fact('Queue position', h('span', { id: 'job-queue-position' }, String(doc.queue_position)))] : []),
+    ];
   }
 
   function draw_head() {
@@ -81,11 +109,10 @@ export function render(main, id) {
         fact('Started', local_time(job.started)),
         fact('Finished', local_time(job.finished)),
         fact('Run time', duration(job.run_seconds)),
-        expected_seconds(job) !== undefined ? fact('Expected', duration(expected_seconds(job))) : null,
+        is_active(job.status) && expected_seconds(job) !== undefined ? fact('Expected (estimate)', duration(expected_seconds(job))) : null,
         fact('Particles', cost.particles ?? '—'),
-        fact('Steps', cost.steps ?? '—'),
-        fact('Time step', cost.dt !== undefined ? `${num(cost.dt)} s` : '—'),
-        fact('Attempts', job.attempts ?? '—')),
+        ...run_facts(job)),
+        fact('Attempts', job.attempts ?? '—'),
     );
     const list = job.warnings || [];
     warnings.replaceChildren(
@@ -201,7 +228,7 @@ export function render(main, id) {
       if (err.name === 'AbortError') return;
       const text = err.status === 410 ? 'The job was dismissed: its result files are deleted.' : `No results: ${err.message}`;
       results_body.replaceChildren(h('p', { class: 'muted' }, text));
-      series_card.hidden = snapshot_card.hidden = true;
+      series_card.hidden = snapshot_card.hidden = profiles_card.hidden = consolidation_card.hidden = true;
       return;
     }
     const files = manifest.files || [];
@@ -218,6 +245,10 @@ export function render(main, id) {
     if (href('series.json')) series_panel(series_body, href('series.json'), () => spec);
     else series_body.replaceChildren(h('p', { class: 'muted' }, 'This job wrote no series (output.series in the spec).'));
     const vtus = files.filter((f) => f.name.endsWith('.vtu'));
+    profiles_card.hidden = !href('profiles.json');
+    if (href('profiles.json')) profiles_panel(profiles_body, href('profiles.json'));
+    consolidation_card.hidden = !href('consolidation.json');
+    if (href('consolidation.json')) consolidation_panel(consolidation_body, href('consolidation.json'));
     if (vtus.length) snapshot_panel(snapshot_body, vtus, href('snapshots.pvd'), () => spec);
     else snapshot_body.replaceChildren(h('p', { class: 'muted' }, 'This job wrote no snapshots (output.snapshots in the spec).'));
   }

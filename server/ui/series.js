@@ -4,7 +4,7 @@
 // chosen time.
 
 import { get_json } from '/ui/api.js';
-import { field_label, h, notice, num } from '/ui/dom.js';
+import { field_label, format_time, h, notice, num, time_unit } from '/ui/dom.js';
 import { line_chart, PALETTE } from '/ui/chart.js';
 import { component_names } from '/ui/vtu.js';
 
@@ -92,14 +92,15 @@ export async function series_panel(root, href) {
     let lines;
     let x_label;
     if (mode.value === 'history') {
-      lines = chosen.map((k) => ({ label: position_label(particles[k]), x: time, y: particles[k][f].map((row) => value_at(row, c)) }));
-      x_label = 'time (s)';
+      const [scale, unit] = time_unit(time[time.length - 1]);
+      lines = chosen.map((k) => ({ label: position_label(particles[k]), x: time.map((t) => t / scale), y: particles[k][f].map((row) => value_at(row, c)) }));
+      x_label = `time (${unit})`;
     } else {
       const a = Number(axis.value);
       const t = Number(step.value);
-      step_label.textContent = `t = ${num(time[t])} s`;
+      step_label.textContent = `t = ${format_time(time[t])}`;
       const ordered = [...chosen].sort((i, j) => particles[i].initial_position[a] - particles[j].initial_position[a]);
-      lines = [{ label: `t = ${num(time[t])} s`, x: ordered.map((k) => particles[k].initial_position[a]), y: ordered.map((k) => value_at(particles[k][f][t], c)) }];
+      lines = [{ label: `t = ${format_time(time[t])}`, x: ordered.map((k) => particles[k].initial_position[a]), y: ordered.map((k) => value_at(particles[k][f][t], c)) }];
       x_label = `initial ${AXES[a]} (m)`;
     }
     chart_box.replaceChildren(line_chart(lines, { x_label, y_label, markers: mode.value === 'profile' }));

@@ -1,4 +1,4 @@
-// particle_layout.hpp — where a body's particles go (internal).
+// particle_layout.hpp — where a body's particles go (internal; problem/layout.cpp).
 //
 // A box body fills the grid cells lying entirely inside its box with n
 // particles per axis per cell at sub-cell centres; a polygon or prism body
@@ -40,5 +40,11 @@ std::vector<BodyLayout> body_layouts(const Problem& problem,
 
 /// Smallest cell size over the active axes, m.
 double min_cell_size(const Problem& problem);
+
+/// Cell size along axis `a`, m.
+double cell_size(const Problem& problem, int a);
+
+/// Volume of one cell (area in 2D, length in 1D).
+double cell_volume(const Problem& problem);
 
 }  // namespace hmpm

@@ -1,5 +1,5 @@
 // test_hints.cpp — every "what to change" hint of the spec checks
-// (api/src/parse/, solver/src/problem.cpp, the schemes' *_rules.cpp, the
+// (api/src/parse/, solver/src/problem/, the schemes' *_rules.cpp, the
 // geostatic checks) points the right way: the change it suggests, applied,
 // removes the error or warning, and the opposite change does not.
 #include <algorithm>

@@ -16,8 +16,8 @@
 #include <nlohmann/json.hpp>
 
 #include "hmpm/api/job.hpp"
+#include "results/writers.hpp"
 #include "test_support.hpp"
-#include "writers.hpp"
 
 namespace hmpm::api {
 namespace {

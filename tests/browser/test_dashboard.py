@@ -59,6 +59,7 @@ class Dashboard(unittest.TestCase):
                 "bar": cls.submit(example("bar-vibration")),
                 "terzaghi": cls.submit(short_terzaghi()),
                 "collapse": cls.submit(example("column-collapse")),
+                "soft-clay": cls.submit(example("soft-clay")),
             }
             for job_id in cls.jobs.values():
                 cls.wait_job(job_id)
@@ -84,6 +85,8 @@ class Dashboard(unittest.TestCase):
     @classmethod
     def call(cls, method, path, body=None):
         req = urllib.request.Request(cls.service.url + path, method=method, data=body)
+        if body:  # the server takes JSON bodies only (415 otherwise)
+            req.add_header("Content-Type", "application/json")
         if TOKEN:
             req.add_header("Authorization", f"Bearer {TOKEN}")
         with urllib.request.urlopen(req, timeout=30) as resp:
@@ -270,6 +273,36 @@ class Dashboard(unittest.TestCase):
         Select(self.driver.find_element(By.ID, "series-mode")).select_by_value("profile")
         dots = wait_until(lambda: self.driver.find_elements(By.CSS_SELECTOR, "#series-chart svg circle"), UI_TIMEOUT_S, "the profile")
         self.assertEqual(len(dots), len(series["particles"]))
+
+    def test_profiles_and_consolidation_of_soft_clay(self):
+        # Issue 44: profiles.json along its (vertical) line against depth
+        # downward, consolidation.json, and the steps and time step that ran.
+        job_id = self.jobs["soft-clay"]
+        self.open(f"#/jobs/{job_id}")
+        chart = self.css("#profile-chart svg[data-y-down='true']")
+        profiles = self.call("GET", f"/jobs/{job_id}/results/profiles.json")
+        paths = chart.find_elements(By.CSS_SELECTOR, "path[data-points]")
+        self.assertEqual(len(paths), len(profiles["time"]))
+        self.assertIn("depth below x = 4.938 m (m)", chart.get_attribute("aria-label"))
+        self.assertIn("pore pressure (Pa)", chart.get_attribute("aria-label"))  # unit from /fields
+        legend = self.driver.find_element(By.ID, "profile-legend").text
+        self.assertIn("days", legend)
+        self.assertIn("t = 0 s", legend)
+        self.css("#consolidation-degree svg path[data-points]")
+        self.assertIn("time (days, log)", self.driver.find_element(By.CSS_SELECTOR, "#consolidation-degree svg").get_attribute("aria-label"))
+        doc = self.call("GET", f"/jobs/{job_id}")
+        steps = self.driver.find_element(By.ID, "job-steps")
+        self.assertEqual(steps.get_attribute("data-source"), "run")
+        self.assertEqual(steps.text, str(doc["run"]["steps"]))
+        self.assertNotEqual(doc["run"]["steps"], doc["cost"]["steps"])
+        # A run shorter than one progress report: its mean step (end / steps).
+        dt = self.driver.find_element(By.ID, "job-dt")
+        self.assertEqual(dt.get_attribute("data-source"), "run")
+        mean = doc["run"]["end_time"] / doc["run"]["steps"]
+        self.assertAlmostEqual(float(dt.text.split()[0]), mean, delta=1e-3 * mean)
+        self.driver.execute_script("document.getElementById('profiles-card').scrollIntoView()")
+        if SCREENSHOTS:
+            self.screenshot("job-profiles")
 
     def test_snapshot_view_draws_the_particles(self):
         self.open(f"#/jobs/{self.jobs['collapse']}")

@@ -1,9 +1,10 @@
 #!/usr/bin/env python3
 """Runs the hostile suite (tests/hostile/test_*.py) and prints its summary:
-per defect item of the hardening issue, the tests that reproduce it and
-their figures; in all, faults survived, bad inputs tried, load held and
-anything lost. Exit 0 only when every test passed, every item 1-11 has a
-passing test and nothing was lost.
+per defect item of each hardening campaign (the first hardening issue,
+items 1-11; issue 45, the second campaign, `record(issue=45, item=N)`), the
+tests that reproduce it and their figures; in all, faults survived, bad
+inputs tried, load held and anything lost. Exit 0 only when every test
+passed, every item of ITEMS has a passing test and nothing was lost.
 
     HMPM_BUILD_DIR=build python3 tests/hostile/run.py [-k PATTERN]
 """
@@ -20,7 +21,11 @@ from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
 REPO = HERE.parents[1]
-ITEMS = range(1, 12)
+# Campaign (the issue number; 0: the first hardening issue) -> its items.
+# Issue 45's items 2 (PostgreSQL submit lock), 5 (slow readers: the test
+# there does not reproduce the cut on loopback, so it is not counted), 7
+# and 8 are not delivered yet.
+ITEMS = {0: range(1, 12), 45: (1, 3, 4, 6, 9, 10)}
 SUMMED = ("faults", "bad_inputs", "requests", "lost")
 
 
@@ -54,18 +59,21 @@ def main(argv) -> int:
           f"{len(result.failures) + len(result.errors)} failed")
     totals = {k: 0 for k in SUMMED}
     missing = []
-    for item in ITEMS:
-        mine = [r for r in rows if r["item"] == item]
-        if not mine:
-            missing.append(item)
-            print(f"  item {item:2d}: NO PASSING TEST")
-            continue
-        for r in mine:
-            extra = {k: v for k, v in r.items() if k not in ("item", "test")}
-            for k in SUMMED:
-                totals[k] += int(extra.get(k, 0) or 0)
-            shown = ", ".join(f"{k}={v}" for k, v in extra.items())
-            print(f"  item {item:2d}: {r['test']}: {shown}")
+    for issue, items in ITEMS.items():
+        print("  first hardening campaign:" if issue == 0 else f"  issue {issue}:")
+        for item in items:
+            mine = [r for r in rows if r["item"] == item and int(r.get("issue", 0)) == issue]
+            label = f"item {item:2d}" if issue == 0 else f"#{issue} item {item:2d}"
+            if not mine:
+                missing.append(label)
+                print(f"  {label}: NO PASSING TEST")
+                continue
+            for r in mine:
+                extra = {k: v for k, v in r.items() if k not in ("item", "test", "issue")}
+                for k in SUMMED:
+                    totals[k] += int(extra.get(k, 0) or 0)
+                shown = ", ".join(f"{k}={v}" for k, v in extra.items())
+                print(f"  {label}: {r['test']}: {shown}")
     print(f"  in all: faults survived {totals['faults']}, bad inputs tried {totals['bad_inputs']}, "
           f"requests answered under load {totals['requests']}, lost {totals['lost']}")
     ok = result.wasSuccessful() and totals["lost"] == 0 and (pattern is not None or not missing)

@@ -7,7 +7,9 @@ folder) and, when it passes, records what it did with `record()`:
     record(item=2, probes=60, answered=60, load="64 slowloris connections, 30 s")
 
 `item` is the number of the defect in the hardening issue (1-11) the test
-reproduces; the other keys are figures the runner sums into its summary:
+reproduces; a test of a later campaign names its issue too
+(`record(issue=45, item=1, ...)`). The other keys are figures the runner
+sums into its summary:
 
     faults     faults injected and survived (kills, full disks, corrupt files)
     bad_inputs hostile inputs sent and answered correctly
@@ -37,11 +39,14 @@ __all__ = ["BAR_SPEC", "COLUMN_SPEC", "LiveServerCase", "ServerProcess", "build_
 FIGURES_ENV = "HMPM_HOSTILE_FIGURES"
 
 
-def record(item: int, **figures) -> None:
+def record(item: int, issue: int = 0, **figures) -> None:
     """Appends one passing test's figures to the file run.py reads."""
     path = os.environ.get(FIGURES_ENV)
     if not path:
         return
     test = os.environ.get("HMPM_HOSTILE_TEST", "")
+    row = {"item": int(item), "test": test, **figures}
+    if issue:
+        row["issue"] = int(issue)
     with open(path, "a", encoding="utf-8") as f:
-        f.write(json.dumps({"item": int(item), "test": test, **figures}) + "\n")
+        f.write(json.dumps(row) + "\n")

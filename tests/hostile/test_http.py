@@ -110,7 +110,7 @@ class SlowlorisTest(unittest.TestCase):
                         try:
                             if socks[i] is None:
                                 socks[i] = connect(server, 2.0)
-                                socks[i].sendall(b"GET /health HTTP/1.1\r\nHost: x\r\n")
+                                socks[i].sendall(b"GET /health HTTP/1.1\r\nHost: 127.0.0.1\r\n")
                             socks[i].sendall(b"X")
                         except OSError:
                             dropped[0] += 1
@@ -169,7 +169,7 @@ class HeaderAndBodyFloodTest(unittest.TestCase):
             def flood():
                 with connect(server, 10.0) as s:
                     try:
-                        s.sendall(b"GET /health HTTP/1.1\r\nHost: x\r\n" + header_block + b"\r\n")
+                        s.sendall(b"GET /health HTTP/1.1\r\nHost: 127.0.0.1\r\n" + header_block + b"\r\n")
                     except OSError:
                         pass  # the server hung up once the limit was passed
                     try:
@@ -192,7 +192,7 @@ class HeaderAndBodyFloodTest(unittest.TestCase):
             big = 16 << 20
             start = time.monotonic()
             with connect(server, 5.0) as s:
-                s.sendall(b"POST /jobs HTTP/1.1\r\nHost: x\r\nContent-Type: application/json\r\n"
+                s.sendall(b"POST /jobs HTTP/1.1\r\nHost: 127.0.0.1\r\nContent-Type: application/json\r\n"
                           b"Content-Length: %d\r\n\r\n" % big)
                 answer = s.recv(4096)
             took = time.monotonic() - start
@@ -208,7 +208,7 @@ class HeaderAndBodyFloodTest(unittest.TestCase):
             def post():
                 with connect(server, 10.0) as s:
                     try:
-                        s.sendall(b"POST /jobs HTTP/1.1\r\nHost: x\r\nContent-Length: %d\r\n\r\n" % big
+                        s.sendall(b"POST /jobs HTTP/1.1\r\nHost: 127.0.0.1\r\nContent-Length: %d\r\n\r\n" % big
                                   + body)
                     except OSError:
                         pass
@@ -292,13 +292,13 @@ class HttpDetailsTest(unittest.TestCase):
             self.assertEqual(h["allow"], "GET, HEAD, POST, OPTIONS")
             self.assertEqual(request(server, "OPTIONS", "/nothing")[0], 404)
             for method in ("FOO", "TRACE", "CONNECT"):
-                answer = raw(server, f"{method} /health HTTP/1.1\r\nHost: x\r\n\r\n".encode())
+                answer = raw(server, f"{method} /health HTTP/1.1\r\nHost: 127.0.0.1\r\n\r\n".encode())
                 self.assertEqual(status_of(answer), 501, (method, answer[:200]))
             bad += 5
 
             # A client that half-closes after sending gets its answer.
             body = json.dumps(BAR_SPEC).encode()
-            answer = raw(server, b"POST /jobs HTTP/1.1\r\nHost: x\r\nContent-Type: application/json\r\n"
+            answer = raw(server, b"POST /jobs HTTP/1.1\r\nHost: 127.0.0.1\r\nContent-Type: application/json\r\n"
                          b"Content-Length: %d\r\n\r\n" % len(body) + body, half_close=True)
             self.assertEqual(status_of(answer), 201, answer[:300])
             bad += 1
@@ -312,7 +312,7 @@ class HttpDetailsTest(unittest.TestCase):
             idle = []
             for _ in range(2):
                 s = connect(server)
-                s.sendall(f"GET /jobs/{long_job}/events HTTP/1.1\r\nHost: x\r\n\r\n".encode())
+                s.sendall(f"GET /jobs/{long_job}/events HTTP/1.1\r\nHost: 127.0.0.1\r\n\r\n".encode())
                 # The first bytes of the answer only: the stream has begun
                 # (its slot is taken) before the probe below, which would
                 # otherwise race it and, answered 200, read a stream of its
@@ -335,7 +335,7 @@ class HttpDetailsTest(unittest.TestCase):
     @staticmethod
     def _stream_opens(server, job) -> bool:
         with connect(server, 3.0) as s:
-            s.sendall(f"GET /jobs/{job}/events HTTP/1.1\r\nHost: x\r\n\r\n".encode())
+            s.sendall(f"GET /jobs/{job}/events HTTP/1.1\r\nHost: 127.0.0.1\r\n\r\n".encode())
             return status_of(s.recv(4096)) == 200
 
     def test_stream_cap_above_http_threads_is_refused(self):

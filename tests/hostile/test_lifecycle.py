@@ -41,7 +41,7 @@ class Trickler(threading.Thread):
         super().__init__(daemon=True)
         u = urlparse(url)
         self.sock = socket.create_connection((u.hostname, u.port), timeout=5)
-        self.sock.sendall(b"GET /health HTTP/1.1\r\nHost: x\r\nX-Slow: ")
+        self.sock.sendall(b"GET /health HTTP/1.1\r\nHost: 127.0.0.1\r\nX-Slow: ")
         self.sent = 0
         self.cut = threading.Event()
         self.done = threading.Event()

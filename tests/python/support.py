@@ -41,7 +41,8 @@ def server_binary() -> Path:
 class ServerProcess:
     """One hmpm-server subprocess; use start()/stop() or `with`."""
 
-    def __init__(self, token: Optional[str] = None, workers: int = 2, extra: Optional[List[str]] = None):
+    def __init__(self, token: Optional[str] = None, workers: Optional[int] = 2,
+                 extra: Optional[List[str]] = None):
         self.token = token
         self.workers = workers
         self.extra = list(extra or [])
@@ -59,8 +60,10 @@ class ServerProcess:
                 f"(cmake -S . -B build -DCMAKE_BUILD_TYPE=Release && cmake --build build --target hmpm-server) "
                 f"or set HMPM_BUILD_DIR to the build folder")
         self.tmp = Path(tempfile.mkdtemp(prefix="hmpm-pytest-"))
-        cmd = [str(exe), "--host", "127.0.0.1", "--port", "0", "--db", str(self.tmp / "db.sqlite"),
-               "--workers", str(self.workers)] + self.extra
+        cmd = [str(exe), "--host", "127.0.0.1", "--port", "0", "--db", str(self.tmp / "db.sqlite")]
+        if self.workers is not None:  # None: the server's default
+            cmd += ["--workers", str(self.workers)]
+        cmd += self.extra
         if self.token:
             cmd += ["--token", self.token]
         env = dict(os.environ)
@@ -128,7 +131,7 @@ class LiveServerCase(unittest.TestCase):
     test gets a fresh temporary folder in `self.tmp`."""
 
     server_token: Optional[str] = None
-    server_workers = 2
+    server_workers: Optional[int] = 2
     server_args: List[str] = []
     server: ServerProcess
 
@@ -223,6 +226,17 @@ def column_spec(cells: int = 10, end: float = 0.05) -> dict:
     spec["time"]["end"] = end
     spec["output"]["series"]["particles"] = [0, cells // 2, cells - 1]
     spec["output"]["series"]["interval"] = end / 10
+    return spec
+
+
+def quasi_static_column_spec() -> dict:
+    """The saturated column (20 cells) in the quasi-static scheme, its step
+    growing from 1 ms to 0.1 s: 41 steps to t = 2 s in milliseconds. The
+    estimate's steps times its first step (0.041 s) is not the end time."""
+    spec = column_spec(cells=20, end=2.0)
+    spec["name"] = "pytest-quasi-static"
+    spec["time"] = {"end": 2.0, "scheme": "quasi_static",
+                    "dt": {"initial": 0.001, "max": 0.1, "growth": 1.2}}
     return spec
 
 

@@ -12,7 +12,8 @@ from unittest import mock
 
 from hmpm_client import Client, HmpmError
 
-from .support import JOB_TIMEOUT_S, LiveServerCase, bar_spec, column_spec, invalid_spec, long_spec, wait_until
+from .support import (JOB_TIMEOUT_S, LiveServerCase, bar_spec, column_spec, invalid_spec, long_spec,
+                      quasi_static_column_spec, wait_until)
 
 
 class ClientTest(LiveServerCase):
@@ -180,6 +181,46 @@ class ClientTest(LiveServerCase):
         self.assertIn("100%", text)
         self.assertIn("successful", text.splitlines()[-1])
 
+    def test_progress_shows_the_servers_simulated_time(self):
+        # Issue 44: the bar multiplied the estimated steps by the first step
+        # (0.041 s here) instead of showing the run's own time (2 s).
+        out = io.StringIO()
+        job = self.client.submit(quasi_static_column_spec())
+        doc = job.wait(progress=True, timeout=JOB_TIMEOUT_S, file=out)
+        self.assertEqual(doc["status"], "successful", doc)
+        run = doc["run"]
+        self.assertEqual(run["end_time"], 2.0)
+        self.assertAlmostEqual(run["simulated_time"], 2.0, places=9)
+        summary = job.summary()
+        self.assertEqual(run["steps"], summary["steps"])
+        # dt range: the growing step's mean over each report lies in [1 ms, 0.1 s].
+        self.assertGreaterEqual(run["dt_min"], 0.001 * (1 - 1e-9))
+        self.assertLessEqual(run["dt_min"], 2.0 / run["steps"] * (1 + 1e-9))
+        self.assertGreaterEqual(run["dt_max"], 2.0 / run["steps"] * (1 - 1e-9))
+        self.assertLessEqual(run["dt_max"], 0.1 * (1 + 1e-9))
+        self.assertIn("t=2/2 s", out.getvalue().splitlines()[-1])
+        # A client that did not submit the spec reads the same from the server.
+        out = io.StringIO()
+        self.client.job(job.id).wait(progress=True, timeout=JOB_TIMEOUT_S, file=out)
+        self.assertIn("t=2/2 s", out.getvalue().splitlines()[-1])
+
+    def test_running_job_reports_simulated_time(self):
+        job = self.client.submit(long_spec())  # t = 0..100 s in steps of 1e-5 s
+        try:
+            self.assertTrue(wait_until(lambda: "run" in job.status(), 30), f"no run in {job.doc}")
+            run = job.doc["run"]
+            self.assertEqual(job.doc["status"], "running")
+            self.assertEqual(run["end_time"], 100.0)
+            self.assertGreater(run["simulated_time"], 0.0)
+            self.assertLess(run["simulated_time"], 100.0)
+            # The stored percent and simulated time come from the same report.
+            self.assertAlmostEqual(run["simulated_time"], job.doc["progress"], delta=1.0)
+            self.assertAlmostEqual(run["steps"] * 1e-5, run["simulated_time"], delta=1e-3)
+            self.assertAlmostEqual(run["dt_min"], 1e-5, delta=1e-12)
+            self.assertAlmostEqual(run["dt_max"], 1e-5, delta=1e-12)
+        finally:
+            job.cancel()
+
     def test_polling_only(self):
         job = self.client.submit(bar_spec())
         doc = job.wait(progress=False, events=False, timeout=JOB_TIMEOUT_S, poll_interval=0.2)
@@ -192,6 +233,60 @@ class ClientTest(LiveServerCase):
                 job.wait(progress=False, timeout=1.0)
         finally:
             job.cancel()
+
+
+class DefaultWorkersTest(LiveServerCase):
+    """Issue 44: with one worker by default, a slow job held every other job
+    in the queue (an OGC execution waited 687 s)."""
+
+    server_workers = None  # the server's default
+
+    def setUp(self):
+        super().setUp()
+        self.client = Client(self.server.url, token="")
+
+    def test_a_short_job_runs_beside_a_long_one(self):
+        long = self.client.submit(long_spec())
+        try:
+            self.assertTrue(wait_until(lambda: long.status()["status"] == "running", 30), long.doc)
+            short = self.client.submit(bar_spec())
+            doc = short.wait(progress=False, timeout=60)
+            self.assertEqual(doc["status"], "successful", doc)
+            self.assertEqual(long.status()["status"], "running")
+        finally:
+            long.cancel()
+
+
+class QueuePositionTest(LiveServerCase):
+    server_workers = 1
+
+    def setUp(self):
+        super().setUp()
+        self.client = Client(self.server.url, token="")
+
+    def test_accepted_jobs_show_their_place_in_the_queue(self):
+        long = self.client.submit(long_spec())
+        waiting = []
+        try:
+            self.assertTrue(wait_until(lambda: long.status()["status"] == "running", 30), long.doc)
+            self.assertNotIn("queue_position", long.doc)
+            waiting = [self.client.submit(bar_spec()) for _ in range(3)]
+            self.assertEqual([j.doc.get("queue_position") for j in waiting], [1, 2, 3])  # the 201s
+            self.assertEqual([j.status().get("queue_position") for j in waiting], [1, 2, 3])
+            listed = {d["jobID"]: d.get("queue_position") for d in self.client.jobs(status="accepted")}
+            self.assertEqual([listed[j.id] for j in waiting], [1, 2, 3])
+            waiting[0].cancel()
+            self.assertEqual([j.status().get("queue_position") for j in waiting], [None, 1, 2])
+        finally:
+            # Cancelling `long` frees the worker, so a waiting bar job may
+            # end between its status and its cancel (409: already ended).
+            for job in [long] + waiting:
+                if job.status()["status"] in ("accepted", "running"):
+                    try:
+                        job.cancel()
+                    except HmpmError as e:
+                        if e.status != 409:
+                            raise
 
 
 class TokenTest(LiveServerCase):

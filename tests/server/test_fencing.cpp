@@ -36,7 +36,7 @@
 #include "job_log.hpp"
 #include "metrics.hpp"
 #include "support.hpp"
-#include "worker_pool.hpp"
+#include "workers/pool.hpp"
 
 namespace hmpm::server {
 namespace {
@@ -60,9 +60,9 @@ class PausedStore : public JobStore {
     return paused_;
   }
 
-  ClaimState update_progress(const Claim& claim, double percent) override {
+  ClaimState record_progress(const Claim& claim, const RunProgress& run) override {
     std::unique_lock<std::mutex> lock(mutex_);
-    if (resumed_) return inner_.update_progress(claim, percent);
+    if (resumed_) return inner_.record_progress(claim, run);
     paused_ = true;
     wake_.notify_all();
     wake_.wait(lock, [&] { return resumed_; });
@@ -200,7 +200,7 @@ TEST(Fencing, ARevivedServerCannotChangeTheFilesOfTheAttemptThatFinished) {
   ASSERT_TRUE(done);
   EXPECT_EQ(done->owner, "server-b");
   EXPECT_GT(done->lease_token, token_a);
-  const auto served = b.results_dir(*done);
+  const auto served = b.files().results_dir(*done);
   EXPECT_EQ(served, data / id / ("attempt-" + std::to_string(done->lease_token)));
   const auto manifest = store->results(id);
   ASSERT_FALSE(manifest.empty());

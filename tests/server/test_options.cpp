@@ -15,7 +15,7 @@ TEST(Options, DefaultsNeedOnlyTheDatabase) {
   ASSERT_TRUE(parsed.config) << parsed.error;
   EXPECT_EQ(parsed.config->host, "127.0.0.1");
   EXPECT_EQ(parsed.config->port, 8080);
-  EXPECT_EQ(parsed.config->workers, 1);
+  EXPECT_EQ(parsed.config->workers, 2);  // a short job runs beside a long one
   EXPECT_EQ(parsed.config->max_attempts, 3);
   EXPECT_TRUE(parsed.config->token.empty());
   EXPECT_TRUE(parsed.config->data_dir.empty());  // resolved to <db dir>/results by the service

@@ -163,7 +163,7 @@ TEST_F(PostgresStoreTest, ManyServersClaimingAtOnceNeverShareAJob) {
         try {
           while (auto got = stores[static_cast<std::size_t>(s)]->claim_next(me)) {
             stores[static_cast<std::size_t>(s)]->finish(
-                claim_of(*got), JobEnd{JobStatus::successful, "finished", "", {}, 0});
+                claim_of(*got), JobEnd{JobStatus::successful, "finished", "", {}, 0, {}});
             std::lock_guard<std::mutex> lock(mutex);
             claimed.insert(got->id);
           }
@@ -198,9 +198,9 @@ TEST_F(PostgresStoreTest, ATakeoverBetweenTwoServersIsFencedAndRecordedAsAttempt
   EXPECT_EQ(first->update_progress(stale, 50), ClaimState::lost);
   EXPECT_EQ(first->record_checkpoint(stale, {"checkpoint-1.bin", 10, 0.1, 5, "ab", ""}),
             ClaimState::lost);
-  EXPECT_EQ(first->finish(stale, JobEnd{JobStatus::successful, "finished", "", {}, 1}),
+  EXPECT_EQ(first->finish(stale, JobEnd{JobStatus::successful, "finished", "", {}, 1, {}}),
             ClaimState::lost);
-  EXPECT_EQ(second->finish(current, JobEnd{JobStatus::successful, "finished", "", {}, 1}),
+  EXPECT_EQ(second->finish(current, JobEnd{JobStatus::successful, "finished", "", {}, 1, {}}),
             ClaimState::held);
   EXPECT_EQ(query("SELECT token, owner, outcome FROM job_attempts ORDER BY token"),
             "1;first;lapsed;2;second;successful;");
@@ -228,7 +228,7 @@ TEST_F(PostgresStoreTest, CheckpointsSurviveRequeueAndRecoveryAndEndWithTheJob) 
   ASSERT_EQ(store->recover(3, 0.0).requeued.size(), 1u);
   EXPECT_EQ(store->checkpoint(id)->step, 120) << "recovery keeps it";
   claim = claim_of(*store->claim_next(Claimant{"c", 600.0}));
-  ASSERT_EQ(store->finish(claim, JobEnd{JobStatus::successful, "finished", "", {}, 1}),
+  ASSERT_EQ(store->finish(claim, JobEnd{JobStatus::successful, "finished", "", {}, 1, {}}),
             ClaimState::held);
   EXPECT_FALSE(store->checkpoint(id)) << "the end of the job clears it";
   // A dismissed job's checkpoint is gone too, and its late writer is told so.

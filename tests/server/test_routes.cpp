@@ -324,7 +324,7 @@ TEST_F(RoutesTest, AllowListsExactlyTheMethodsServed) {
       const std::string body = method == "POST" ? "{}" : "";
       const std::string answer =
           raw_http(port_,
-                   method + " " + path + " HTTP/1.1\r\nHost: x\r\nConnection: close\r\n" +
+                   method + " " + path + " HTTP/1.1\r\nHost: 127.0.0.1\r\nConnection: close\r\n" +
                        "Content-Length: " + std::to_string(body.size()) + "\r\n\r\n" + body,
                    5.0);
       EXPECT_NE(raw_status(answer), 405) << method << " " << path << " is listed in Allow";
@@ -338,22 +338,24 @@ TEST_F(RoutesTest, BodiesWithoutLengthOrOverTheLimitAreRefused) {
   c.max_body_bytes = std::size_t{64} * 1024;
   start(c);
   std::string res =
-      raw_http(port_, "POST /jobs HTTP/1.1\r\nHost: x\r\nConnection: close\r\n\r\n{}");
+      raw_http(port_, "POST /jobs HTTP/1.1\r\nHost: 127.0.0.1\r\nConnection: close\r\n\r\n{}");
   EXPECT_EQ(raw_status(res), 411) << res;
   EXPECT_EQ(json_of(raw_body(res)).value("type", ""), "length-required");
-  res = raw_http(port_,
-                 "POST /jobs HTTP/1.1\r\nHost: x\r\nTransfer-Encoding: chunked\r\nConnection: "
-                 "close\r\n\r\n2\r\n{}\r\n0\r\n\r\n");
+  res = raw_http(
+      port_,
+      "POST /jobs HTTP/1.1\r\nHost: 127.0.0.1\r\nTransfer-Encoding: chunked\r\nConnection: "
+      "close\r\n\r\n2\r\n{}\r\n0\r\n\r\n");
   EXPECT_EQ(raw_status(res), 411) << res;
   res = raw_http(
-      port_, "POST /jobs HTTP/1.1\r\nHost: x\r\nContent-Length: abc\r\nConnection: close\r\n\r\n");
+      port_,
+      "POST /jobs HTTP/1.1\r\nHost: 127.0.0.1\r\nContent-Length: abc\r\nConnection: close\r\n\r\n");
   EXPECT_EQ(raw_status(res), 400) << res;
 
   const std::string big(std::size_t{200} * 1024, ' ');
   expect_problem(client_->Post("/jobs", big, "application/json"), 413, "payload-too-large");
-  res = raw_http(port_,
-                 "POST /jobs HTTP/1.1\r\nHost: x\r\nContent-Length: " + std::to_string(big.size()) +
-                     "\r\nExpect: 100-continue\r\nConnection: close\r\n\r\n");
+  res = raw_http(port_, "POST /jobs HTTP/1.1\r\nHost: 127.0.0.1\r\nContent-Length: " +
+                            std::to_string(big.size()) +
+                            "\r\nExpect: 100-continue\r\nConnection: close\r\n\r\n");
   EXPECT_EQ(raw_status(res), 413) << res;  // refused before the body is sent
   EXPECT_EQ(client_->Get("/health")->status, 200);
 }
@@ -392,7 +394,8 @@ TEST_F(RoutesTest, ResultNamesOutsideTheManifestAreRefused) {
   }
   const std::string res = raw_http(
       port_,
-      "GET " + base + "../../../db/hmpm.sqlite HTTP/1.1\r\nHost: x\r\nConnection: close\r\n\r\n");
+      "GET " + base +
+          "../../../db/hmpm.sqlite HTTP/1.1\r\nHost: 127.0.0.1\r\nConnection: close\r\n\r\n");
   EXPECT_EQ(raw_status(res), 404) << res;
   EXPECT_EQ(client_->Get((base + "summary.json").c_str())->status, 200);
 }

@@ -37,15 +37,19 @@ struct Column {
 };
 
 /// sigma' and p at `depths` (from the top) at each of `times`, rows in time
-/// order: out[t][2 d] = sigma', out[t][2 d + 1] = p.
+/// order: out[t][2 d] = sigma', out[t][2 d + 1] = p. The column starts at
+/// rest with sigma' = 0 and p = initial_pressure (Terzaghi's start: p = q
+/// with the load q carried by the water, the top drained from t = 0).
 inline std::vector<std::vector<double>> reference(const Column& c,
                                                   const std::function<double(double)>& load,
                                                   int cells, const std::vector<double>& times,
-                                                  const std::vector<double>& depths) {
+                                                  const std::vector<double>& depths,
+                                                  double initial_pressure = 0.0) {
   const int n = cells;
   const double h = c.H / n, rho = c.rho();
   const double dt = 0.25 * std::min(h / c.fast_speed(), c.storage * h * h / (2 * c.kappa));
-  std::vector<double> v(n + 1, 0.0), a(n + 1, 0.0), w(n + 1, 0.0), s(n, 0.0), p(n, 0.0);
+  std::vector<double> v(n + 1, 0.0), a(n + 1, 0.0), w(n + 1, 0.0), s(n, 0.0),
+      p(n, initial_pressure);
   std::vector<std::vector<double>> out;
   // Linear interpolation of a cell-centred field at depth z (p = 0 at the
   // top face, where the last cell's value is extrapolated for sigma').

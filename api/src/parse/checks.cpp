@@ -335,7 +335,8 @@ void check_position_formulas(ParseContext& c) {
 void check_limits(ParseContext& c) {
   const Problem& p = c.p;
   const Limits& limits = c.limits;
-  const CostEstimate cost = estimate_cost(p);
+  c.cost = estimate_cost(p, c.calibration);
+  const CostEstimate& cost = *c.cost;
   const StableStep s = stable_step(p);
   const double steps = static_cast<double>(s.steps);
   if (steps > static_cast<double>(limits.max_steps)) {

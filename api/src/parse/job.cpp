@@ -26,11 +26,8 @@ constexpr std::string_view top_required[] = {"dimension", "grid", "materials", "
 // At most this many errors are reported (then one line counting the rest).
 constexpr std::size_t max_errors = 1000;
 
-// The first character of `s` (UTF-8, which the JSON parser has checked)
-// that a job name may not hold: C0 and C1 control characters (NUL, line
-// breaks, escape sequences) and the bidirectional controls that make a name
-// show as something else (U+061C, U+200E, U+200F, U+202A-U+202E,
-// U+2066-U+2069). Returns its position (in characters) and code point.
+}  // namespace
+
 std::optional<std::pair<std::size_t, char32_t>> forbidden_in_name(std::string_view s) {
   std::size_t position = 0;
   for (std::size_t i = 0; i < s.size(); ++position) {
@@ -43,25 +40,43 @@ std::optional<std::pair<std::size_t, char32_t>> forbidden_in_name(std::string_vi
     const bool control = cp < 0x20 || (cp >= 0x7F && cp <= 0x9F);
     const bool bidi = cp == 0x061C || cp == 0x200E || cp == 0x200F ||
                       (cp >= 0x202A && cp <= 0x202E) || (cp >= 0x2066 && cp <= 0x2069);
-    if (control || bidi) return std::pair{position, cp};
+    // Characters that show as nothing (or as a blank): zero-width spaces
+    // and joiners, the soft hyphen, invisible operators, fillers, the byte
+    // order mark, interlinear annotations, tag characters.
+    const bool invisible = cp == 0x00AD || cp == 0x034F || cp == 0x115F || cp == 0x1160 ||
+                           cp == 0x17B4 || cp == 0x17B5 || (cp >= 0x180B && cp <= 0x180F) ||
+                           (cp >= 0x200B && cp <= 0x200D) || (cp >= 0x2060 && cp <= 0x2064) ||
+                           (cp >= 0x206A && cp <= 0x206F) || cp == 0x3164 || cp == 0xFEFF ||
+                           cp == 0xFFA0 || (cp >= 0xFFF9 && cp <= 0xFFFB) ||
+                           (cp >= 0x1D173 && cp <= 0x1D17A) || (cp >= 0xE0000 && cp <= 0xE007F);
+    if (control || bidi || invisible) return std::pair{position, cp};
   }
   return std::nullopt;
 }
 
-void read_name(ParseContext& c, const json& j) {
-  auto s = c.r.string(j, "/name", 200);
-  if (!s) return;
+std::optional<std::string> read_label(ParseContext& c, const json& j, const std::string& path,
+                                      std::size_t max_characters, const char* what) {
+  auto s = c.r.string(j, path, max_characters);
+  if (!s) return std::nullopt;
   if (const auto bad = forbidden_in_name(*s)) {
     char code[16];
     std::snprintf(code, sizeof code, "U+%04X", static_cast<unsigned>(bad->second));
-    c.r.error("/name", std::string("holds ") + code + " at character " +
-                           std::to_string(bad->first + 1) +
-                           "; a job name may not contain control characters (U+0000-U+001F, "
-                           "U+007F-U+009F) or bidirectional controls (U+061C, U+200E, U+200F, "
-                           "U+202A-U+202E, U+2066-U+2069): remove it");
-    return;
+    c.r.error(path, std::string("holds ") + code + " at character " +
+                        std::to_string(bad->first + 1) + "; " + what +
+                        " may not contain control characters (U+0000-U+001F, U+007F-U+009F), "
+                        "bidirectional controls (U+061C, U+200E, U+200F, U+202A-U+202E, "
+                        "U+2066-U+2069) or invisible characters (zero-width spaces and "
+                        "joiners U+200B-U+200D, U+2060-U+2064, U+FEFF, the soft hyphen U+00AD, "
+                        "fillers, tags): remove it");
+    return std::nullopt;
   }
-  c.name = *s;
+  return s;
+}
+
+namespace {
+
+void read_name(ParseContext& c, const json& j) {
+  if (auto s = read_label(c, j, "/name", 200, "a job name")) c.name = *s;
 }
 
 void read_root(ParseContext& c, const json& root) {
@@ -99,7 +114,8 @@ void read_root(ParseContext& c, const json& root) {
     r.error(c.first_pore_pressure_bc, "prescribes pore pressure but no material has 'hydraulic'");
 }
 
-ParseResult parse_text(std::string_view text, const Limits& limits) {
+ParseResult parse_text(std::string_view text, const Limits& limits,
+                       const Calibration& calibration) {
   ParseResult result;
   if (text.size() > static_cast<std::size_t>(limits.max_body_bytes)) {
     result.errors.push_back({"", "spec is " + std::to_string(text.size()) +
@@ -108,9 +124,12 @@ ParseResult parse_text(std::string_view text, const Limits& limits) {
     return result;
   }
   json root;
-  if (!parse_json_guarded(text, limits.max_json_depth, root, result.errors)) return result;
-  ParseContext c(limits);
+  const TopArrayLimit stage_limit{"stages", max_stages, " (merge stages, or split the job)"};
+  if (!parse_json_guarded(text, limits.max_json_depth, root, result.errors, stage_limit))
+    return result;
+  ParseContext c(limits, calibration);
   read_root(c, root);
+  if (c.r.error_count() == 0) check_stage_budget(c);
   if (c.r.error_count() == 0) check_whole_problem(c);
   result.errors = std::move(c.r.errors());
   // A hostile spec can hold millions of mistakes; the first thousand say enough.
@@ -123,7 +142,7 @@ ParseResult parse_text(std::string_view text, const Limits& limits) {
     ParsedJob job;
     job.name = c.name;
     job.profiles = std::move(c.profiles);
-    job.cost = estimate_cost(c.p);
+    job.cost = c.cost ? std::move(*c.cost) : estimate_cost(c.p, calibration);
     job.warnings = std::move(c.warnings);
     for (const ProblemIssue& w : problem_warnings(c.p))
       job.warnings.push_back({pointer_of_solver_location(w.where), w.message});
@@ -159,9 +178,10 @@ const std::vector<SpecObjectKeys>& spec_object_keys() {
   return table;
 }
 
-ParseResult parse_job(std::string_view json_text, const Limits& limits) {
+ParseResult parse_job(std::string_view json_text, const Limits& limits,
+                      const Calibration& calibration) {
   try {
-    return parse::parse_text(json_text, limits);
+    return parse::parse_text(json_text, limits, calibration);
   } catch (const std::exception& e) {
     ParseResult r;
     r.errors.push_back({"", std::string("internal error while reading the spec: ") + e.what()});

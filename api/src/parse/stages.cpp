@@ -50,7 +50,7 @@ std::vector<int> read_body_list(ParseContext& c, const json& j, const std::strin
 void read_stage(ParseContext& c, const json& j, const std::string& path, Stage& s) {
   if (!c.r.object(j, path, stage_allowed, stage_required)) return;
   if (j.contains("name"))
-    if (auto n = c.r.string(j["name"], path + "/name", 200)) s.name = *n;
+    if (auto n = read_label(c, j["name"], path + "/name", 200, "a stage name")) s.name = *n;
   c.r.number_at(j, path, "end", Range::positive(), s.end);
   if (j.contains("add_bodies"))
     s.add_bodies = read_body_list(c, j["add_bodies"], path + "/add_bodies");
@@ -102,11 +102,38 @@ void stage_keys(std::vector<SpecObjectKeys>& out) {
 
 void read_stages(ParseContext& c, const json& j, const std::string& path) {
   if (!c.r.array(j, path, 1)) return;
+  if (j.size() > max_stages) {
+    c.r.error(path, "has " + std::to_string(j.size()) + " stages; the limit is " +
+                        std::to_string(max_stages) + " (merge stages, or split the job)");
+    return;
+  }
   for (std::size_t i = 0; i < j.size(); ++i) {
     Stage s;
     s.name = "stage " + std::to_string(i + 1);
     read_stage(c, j[i], child_pointer(path, i), s);
     c.p.stages.push_back(std::move(s));
+  }
+}
+
+void check_stage_budget(ParseContext& c) {
+  const Problem& p = c.p;
+  if (p.stages.empty()) return;
+  std::size_t items = p.materials.size() + p.bodies.size() + p.boundaries.size() +
+                      p.tractions.size() + p.fluxes.size();
+  for (const Stage& s : p.stages) {
+    items += s.add_bodies.size() + s.remove_bodies.size();
+    if (s.boundaries) items += s.boundaries->size();
+    if (s.tractions) items += s.tractions->size();
+    if (s.fluxes) items += s.fluxes->size();
+  }
+  if (p.stages.size() * items > max_stage_items_product) {
+    c.r.error("/stages", "has " + std::to_string(p.stages.size()) + " stages in a problem of " +
+                             std::to_string(items) +
+                             " materials, bodies, boundaries, tractions and fluxes: each "
+                             "stage is checked with the whole problem in force, so their product "
+                             "is limited to " +
+                             std::to_string(max_stage_items_product) +
+                             " (merge stages, or split the job)");
   }
 }
 

@@ -1,6 +1,6 @@
 // tables.cpp — the parser's tables as one JSON document (`hmpm spec-keys`):
 // the accepted keys of every object, the values of every enumeration, the
-// output fields with their kinds and the material models with their
+// output fields with their kinds and units and the material models with their
 // parameters. The JSON Schema test (tests/api/check_schema.py) and the
 // result checks compare against it instead of keeping their own copies.
 #include <cmath>
@@ -42,7 +42,9 @@ std::string spec_tables_json() {
   };
   json& fields = doc["fields"] = json::array();
   for (const FieldInfo& f : field_table)
-    fields.push_back({{"name", std::string(f.name)}, {"kind", std::string(kind_name(f.kind))}});
+    fields.push_back({{"name", std::string(f.name)},
+                      {"kind", std::string(kind_name(f.kind))},
+                      {"unit", std::string(f.unit)}});
   json& models = doc["models"] = json::array();
   for (const parse::MaterialModel& m : parse::material_models()) {
     json parameters = json::array();

@@ -217,6 +217,17 @@ def cmd_download(client: Client, args) -> int:
     return EXIT_OK
 
 
+def _field_units(client: Client) -> dict:
+    """The fields' units from the service (GET /fields); {} with a note on
+    stderr when it cannot be asked (a local folder plotted offline)."""
+    try:
+        return client.field_units()
+    except (HmpmError, OSError, ValueError) as e:
+        _err(f"note: the field units come from the service's /fields, which could not be read "
+             f"({e}): the value axes carry no unit")
+        return {}
+
+
 def cmd_plot(client: Client, args) -> int:
     from .plot import MatplotlibMissing, plot_consolidation, plot_profile, plot_series
     local = Path(args.id)
@@ -249,9 +260,10 @@ def cmd_plot(client: Client, args) -> int:
         if args.consolidation:
             plot_consolidation(doc, out, title=title.split(": ")[0] + ": degree of consolidation")
         elif profile:
-            plot_profile(doc, args.field, out, line=args.profile, title=title + f", profile {args.profile}")
+            plot_profile(doc, args.field, out, line=args.profile, title=title + f", profile {args.profile}",
+                         units=_field_units(client))
         else:
-            plot_series(doc, args.field, out, title=title)
+            plot_series(doc, args.field, out, title=title, units=_field_units(client))
     except MatplotlibMissing as e:
         _err(str(e))
         return EXIT_NO_MATPLOTLIB

@@ -143,6 +143,18 @@ class Client:
         """`GET /health`: the service's health document."""
         return self.request("GET", "/health")
 
+    def fields(self) -> Dict[str, Any]:
+        """`GET /fields`: the output fields with their kinds and units
+        (`{"fields": [{"name", "kind", "unit"}, ...], "time_unit": "s"}`),
+        the solver's table; the plots take their axis units from it."""
+        doc = self.request("GET", "/fields")
+        return doc if isinstance(doc, dict) else {}
+
+    def field_units(self) -> Dict[str, str]:
+        """{field name: unit} from `fields()`."""
+        from .units import field_units
+        return field_units(self.fields())
+
     def submit(self, spec: SpecLike, idempotency_key: Optional[str] = None) -> "Job":
         """Submits a job spec and returns its Job (status `accepted`).
 
@@ -212,9 +224,14 @@ def _spec_bytes(spec: SpecLike) -> bytes:
 
 
 def _spec_end_time(body: bytes) -> Optional[float]:
-    """The spec's `time.end` in seconds, or None."""
+    """The job's end in seconds: the last stage's `end` of a staged spec,
+    else `time.end`; None when the spec does not say."""
     try:
-        end = json.loads(body.decode("utf-8")).get("time", {}).get("end")
+        spec = json.loads(body.decode("utf-8"))
+        stages = spec.get("stages")
+        end = stages[-1].get("end") if isinstance(stages, list) and stages else None
+        if end is None:
+            end = spec.get("time", {}).get("end")
     except (ValueError, UnicodeDecodeError, AttributeError):
         return None
     return float(end) if isinstance(end, (int, float)) and not isinstance(end, bool) else None

@@ -6,10 +6,15 @@ place with a carriage return; when the output is a file or a pipe (CI logs,
 tests) a new line is written only when the status changes or the progress
 crosses another 10 %, so logs stay short. `finish(doc)` ends the line.
 
-When the service reports only the percentage, the simulated time shown is
-that fraction of the run's end time: `cost.steps * cost.dt` from hmpm-server's
-status document, or the spec's `time.end` when this client submitted it. The ETA is extrapolated from the progress rate observed by this client since
-the job started running; it is never taken from the server's clock.
+The simulated time and end time shown are the server's own: hmpm-server's
+status document carries them in `run` (`simulated_time`, `end_time`, the
+solver's figures, stored with the progress) once the job runs. Before that,
+or from a service that reports only the percentage, the simulated time is
+that fraction of the spec's `time.end` when this client submitted it (never
+an estimate from `cost`: the steps of a quasi-static or staged run are not
+all of the first step's size). The ETA is extrapolated from the progress rate
+observed by this client since the job started running; it is never taken
+from the server's clock.
 """
 
 from __future__ import annotations
@@ -47,6 +52,17 @@ def format_duration(seconds: Optional[float]) -> str:
 
 def format_sim_time(t: float) -> str:
     return f"{t:.4g}"
+
+
+def format_sim_span(t: float, end: Optional[float] = None) -> str:
+    """`t` (and `end`) in the time unit that reads best for `end` (or `t`):
+    `t=12.5/30 s`, `t=3.2/10 days`, `t=0.8/5 years`."""
+    from .units import time_unit  # local: units has no dependency on this module
+
+    scale, unit = time_unit(end if end is not None else t)
+    if end is None:
+        return f"t={format_sim_time(t / scale)} {unit}"
+    return f"t={format_sim_time(t / scale)}/{format_sim_time(end / scale)} {unit}"
 
 
 class ProgressBar:
@@ -89,21 +105,17 @@ class ProgressBar:
         parts = [f"{self.job_id[:8]} {status:<10}", f"[{bar}]", f"{p:3.0f}%"]
         sim = _number(doc, _SIM_TIME_KEYS)
         end = _number(doc, _END_TIME_KEYS)
-        cost = doc.get("cost")
-        if end is None and isinstance(cost, dict):
-            # hmpm-server's status document carries the step count and size.
-            steps, dt = _number(cost, ("steps",)), _number(cost, ("dt",))
-            if steps and dt:
-                end = steps * dt
-        if end is not None:
+        run = doc.get("run")
+        if isinstance(run, dict):  # hmpm-server: what the solver reached
+            sim = _number(run, _SIM_TIME_KEYS) if sim is None else sim
+            end = _number(run, _END_TIME_KEYS) if end is None else end
+        if end is not None and end > 0:
             self._end_time = end
         end = self._end_time
         if sim is None and end is not None and status in ("running", "successful"):
             sim = end * p / 100.0  # progress is the fraction of simulated time done
-        if sim is not None and end is not None:
-            parts.append(f"t={format_sim_time(sim)}/{format_sim_time(end)} s")
-        elif sim is not None:
-            parts.append(f"t={format_sim_time(sim)} s")
+        if sim is not None:
+            parts.append(format_sim_span(sim, end))
         if status == "running":
             parts.append("ETA " + format_duration(self.eta(p)))
         elif status == "accepted":

@@ -1,13 +1,16 @@
 // connection.cpp — see connection.hpp.
 #include "connection.hpp"
 
+#include <linux/sockios.h>
 #include <netdb.h>
 #include <poll.h>
+#include <sys/ioctl.h>
 #include <sys/socket.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <array>
+#include <cctype>
 #include <chrono>
 #include <condition_variable>
 #include <deque>
@@ -22,6 +25,7 @@ namespace {
 using SteadyClock = std::chrono::steady_clock;
 
 thread_local StreamLimit stream_limit = StreamLimit::none;
+thread_local std::string malformed_reason;
 thread_local bool close_requested = false;
 thread_local bool routed = false;
 
@@ -61,6 +65,25 @@ void address_of(socket_t sock, bool peer, std::string& ip, int& port) {
   }
 }
 
+bool is_token_char(char c) {
+  const auto u = static_cast<unsigned char>(c);
+  if (std::isalnum(u) != 0) return true;
+  return std::string_view("!#$%&'*+-.^_`|~").find(c) != std::string_view::npos;
+}
+
+bool same_name(std::string_view a, std::string_view b) {
+  return a.size() == b.size() && std::equal(a.begin(), a.end(), b.begin(), [](char x, char y) {
+           return std::tolower(static_cast<unsigned char>(x)) ==
+                  std::tolower(static_cast<unsigned char>(y));
+         });
+}
+
+std::string_view trim_blanks(std::string_view v) {
+  while (!v.empty() && (v.front() == ' ' || v.front() == '\t')) v.remove_prefix(1);
+  while (!v.empty() && (v.back() == ' ' || v.back() == '\t')) v.remove_suffix(1);
+  return v;
+}
+
 // One connection's byte stream as httplib's parser sees it (one object for
 // the connection's life, so pipelined bytes stay buffered between requests).
 class DeadlineStream final : public httplib::Stream {
@@ -77,6 +100,7 @@ class DeadlineStream final : public httplib::Stream {
   void begin_request() {
     in_head_ = true;
     head_bytes_ = 0;
+    head_.clear();
     head_lines_ = 0;
     line_length_ = 0;
     deadline_ = after(limits_.head_timeout_s);
@@ -103,11 +127,19 @@ class DeadlineStream final : public httplib::Stream {
       for (std::size_t i = 0; i < n; ++i) {
         const char c = buffer_[begin_ + i];
         ++head_bytes_;
+        head_.push_back(c);
         if (c == '\n') {
           ++head_lines_;
           const bool blank = line_length_ == 0;
           line_length_ = 0;
           if (blank) {
+            // The whole head is here: refuse it before httplib parses it
+            // its own, laxer way.
+            malformed_reason = head_problem(head_);
+            if (!malformed_reason.empty()) {
+              stream_limit = StreamLimit::malformed_head;
+              return -1;
+            }
             in_head_ = false;
             deadline_ = after(limits_.body_timeout_s);
             n = i + 1;
@@ -131,7 +163,7 @@ class DeadlineStream final : public httplib::Stream {
   ssize_t write(const char* ptr, std::size_t size) override {
     std::size_t done = 0;
     while (done < size) {
-      if (!wait_for(sock_, POLLOUT, write_timeout_ms_)) return -1;
+      if (!writable_or_draining()) return -1;
       const ssize_t n = ::send(sock_, ptr + done, size - done, MSG_NOSIGNAL);
       if (n < 0 && errno == EINTR) continue;
       if (n <= 0) return -1;
@@ -149,6 +181,25 @@ class DeadlineStream final : public httplib::Stream {
   socket_t socket() const override { return sock_; }
 
  private:
+  // Waits until the socket takes more bytes. A client that keeps reading,
+  // however slowly, is waited for: only a send queue that has not shrunk
+  // for the write timeout (a stalled reader) gives up. (POLLOUT alone comes
+  // only once a third of the send buffer is free, which a reader at a few
+  // hundred kB/s takes longer than the timeout to make.)
+  bool writable_or_draining() const {
+    constexpr int slice_ms = 250;
+    int queued = -1;
+    auto stalled_at = after(write_timeout_ms_ / 1000.0);
+    for (;;) {
+      if (wait_for(sock_, POLLOUT, std::min(slice_ms, write_timeout_ms_))) return true;
+      int now_queued = 0;
+      if (::ioctl(sock_, SIOCOUTQ, &now_queued) != 0) return false;
+      if (queued < 0 || now_queued < queued) stalled_at = after(write_timeout_ms_ / 1000.0);
+      queued = now_queued;
+      if (SteadyClock::now() >= stalled_at) return false;
+    }
+  }
+
   // Reads what the socket has, waiting until the current deadline (and at
   // most the read timeout between two arrivals, as httplib does); false on
   // a timeout, EOF or error, and for a head still incomplete when the server
@@ -190,6 +241,7 @@ class DeadlineStream final : public httplib::Stream {
   std::size_t end_ = 0;
   bool in_head_ = true;
   std::size_t head_bytes_ = 0;
+  std::string head_;  ///< the head so far (at most max_head_bytes)
   std::size_t head_lines_ = 0;
   std::size_t line_length_ = 0;
   SteadyClock::time_point deadline_ = SteadyClock::now();
@@ -276,6 +328,71 @@ int to_ms(time_t sec, time_t usec) {
 
 StreamLimit current_stream_limit() {
   return stream_limit;
+}
+
+const std::string& malformed_head_reason() {
+  return malformed_reason;
+}
+
+std::string head_problem(std::string_view head) {
+  if (head.find('\0') != std::string_view::npos) return "the request head holds a NUL byte";
+  for (std::size_t i = 0; i < head.size(); ++i) {
+    if (head[i] == '\n' && (i == 0 || head[i - 1] != '\r'))
+      return "a line of the request head ends in LF without CR";
+    if (head[i] == '\r' && (i + 1 == head.size() || head[i + 1] != '\n'))
+      return "the request head holds a CR that does not end a line";
+  }
+  std::size_t pos = head.find("\r\n");
+  const std::string_view request_line = head.substr(0, pos);
+  if (request_line.empty()) return "the request line is empty";
+  const auto space = request_line.rfind(' ');
+  const std::string_view version =
+      space == std::string_view::npos ? std::string_view() : request_line.substr(space + 1);
+  std::size_t hosts = 0;
+  std::string_view length;
+  pos += 2;
+  while (pos < head.size()) {
+    const std::size_t end = head.find("\r\n", pos);
+    const std::string_view line = head.substr(pos, end - pos);
+    pos = end + 2;
+    if (line.empty()) break;  // the blank line that ends the head
+    if (line.front() == ' ' || line.front() == '\t')
+      return "a header line is folded onto the one before (obs-fold)";
+    const auto colon = line.find(':');
+    if (colon == std::string_view::npos) return "a header line has no colon";
+    const std::string_view name = line.substr(0, colon);
+    if (name.empty() || !std::all_of(name.begin(), name.end(), is_token_char)) {
+      return "header field name '" + std::string(name.substr(0, 64)) +
+             "' is not a token (white space before the colon?)";
+    }
+    const std::string_view value = line.substr(colon + 1);
+    for (const char c : value) {
+      const auto u = static_cast<unsigned char>(c);
+      if ((u < 0x20 && c != '\t') || u == 0x7f)
+        return "header " + std::string(name) + " holds a control character";
+    }
+    if (same_name(name, "Host")) {
+      ++hosts;
+      if (trim_blanks(value).empty()) return "the Host header is empty";
+    }
+    if (same_name(name, "Content-Length")) {
+      // Several Content-Length lines (or a list in one) must agree.
+      std::string_view rest = value;
+      while (true) {
+        const auto comma = rest.find(',');
+        const std::string_view item = trim_blanks(rest.substr(0, comma));
+        if (!length.empty() && item != length) return "two different Content-Length values";
+        if (length.empty()) length = item;
+        if (comma == std::string_view::npos) break;
+        rest = rest.substr(comma + 1);
+      }
+    }
+  }
+  if (version == "HTTP/1.1" && hosts != 1)
+    return hosts == 0 ? "an HTTP/1.1 request needs a Host header"
+                      : "the request has more than one Host header";
+  if (hosts > 1) return "the request has more than one Host header";
+  return {};
 }
 
 void note_routed() {

@@ -24,6 +24,8 @@
 
 #include <atomic>
 #include <cstddef>
+#include <string>
+#include <string_view>
 
 namespace hmpm::server::http {
 
@@ -39,8 +41,20 @@ struct ConnectionLimits {
 
 /// Why the current request's head or body was cut off (for the status the
 /// error handler answers); per thread, reset for every request.
-enum class StreamLimit { none, head_timeout, head_too_large, body_timeout };
+enum class StreamLimit { none, head_timeout, head_too_large, body_timeout, malformed_head };
 StreamLimit current_stream_limit();
+/// For StreamLimit::malformed_head: what is wrong with the head (for the 400).
+const std::string& malformed_head_reason();
+
+/// What is wrong with a complete request head (request line, header lines
+/// and the blank line, as received), or "" when it is well formed. Stricter
+/// than httplib, which skips lines it cannot parse and takes the first of
+/// repeated fields, so that the server and a proxy in front of it never
+/// read one request two ways: every line ends in CRLF; no NUL, no other
+/// control character but HTAB in a field; no folded lines (obs-fold); every
+/// field line is `token ":" value` (no white space before the colon); at
+/// most one Content-Length value; HTTP/1.1 with exactly one Host.
+std::string head_problem(std::string_view head);
 
 /// The pre-routing handler calls note_routed(): the head of the current
 /// request was read and parsed (errors after it are the handlers').

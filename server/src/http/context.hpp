@@ -9,9 +9,10 @@
 #include "hmpm/api/job.hpp"
 #include "hmpm/server/service.hpp"
 #include "hmpm/server/store.hpp"
+#include "job_files.hpp"
 #include "metrics.hpp"
 #include "validation_gate.hpp"
-#include "worker_pool.hpp"
+#include "workers/pool.hpp"
 
 namespace hmpm::server::http {
 
@@ -21,6 +22,7 @@ struct Context {
   JobStore& store;
   Metrics& metrics;
   WorkerPool& workers;
+  const JobFiles& files;              ///< the jobs' folders (log, results)
   const std::atomic<bool>& stopping;  ///< set by Service::stop()
   ValidationGate& validation;         ///< turns to parse a spec (POST /jobs, /validate)
 };

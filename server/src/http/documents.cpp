@@ -32,6 +32,15 @@ Json cost_document(const JobCost& cost) {
               {"output_bytes", cost.output_bytes}};
 }
 
+Json run_document(const RunProgress& run) {
+  Json doc{{"simulated_time", run.time}, {"end_time", run.end_time}, {"steps", run.steps}};
+  if (run.dt_max > 0) {
+    doc["dt_min"] = run.dt_min;
+    doc["dt_max"] = run.dt_max;
+  }
+  return doc;
+}
+
 Json status_document(const JobRecord& job) {
   const std::string self = "/jobs/" + job.id;
   Json doc{{"jobID", job.id},
@@ -47,7 +56,10 @@ Json status_document(const JobRecord& job) {
            {"updated", job.updated},
            {"attempts", job.attempts}};
   if (!job.failure_reason.empty()) doc["reason"] = job.failure_reason;
+  if (job.status == JobStatus::accepted && job.queue_position > 0)
+    doc["queue_position"] = job.queue_position;
   doc["cost"] = cost_document(job.cost);
+  if (job.run.end_time > 0) doc["run"] = run_document(job.run);
   if (job.run_seconds > 0) doc["run_seconds"] = job.run_seconds;
   doc["links"] = Json::array(
       {link(self, "self", "application/json", "this status document"),

@@ -21,6 +21,10 @@ Json link(const std::string& href, const char* rel, const char* type, const char
 /// The `cost` member of the status document (and of POST /validate).
 Json cost_document(const JobCost& cost);
 
+/// The `run` member of the status document: what the run reached (the
+/// solver's simulated time and end time, steps, the time-step range).
+Json run_document(const RunProgress& run);
+
 /// The status document of `job`.
 Json status_document(const JobRecord& job);
 

@@ -56,6 +56,9 @@ void get_process(Context& c, const httplib::Request& req, httplib::Response& res
 void execute_process(Context& c, const httplib::Request& req, httplib::Response& res,
                      const std::string& body);
 
+// fields.cpp — the output fields with their kinds and units (no token).
+void get_fields(Context& c, const httplib::Request& req, httplib::Response& res);
+
 // ui.cpp — the dashboard's files, compiled in (server/ui).
 void get_ui(Context& c, const httplib::Request& req, httplib::Response& res);
 

@@ -32,22 +32,22 @@ JobCost cost_of(const hmpm::api::CostEstimate& c) {
                  .dt = c.dt};
 }
 
-// The estimate with this server's calibration and threads per job: what
-// the limits are checked against and the 201 and /validate show.
-hmpm::api::CostEstimate server_estimate(const Context& c, const hmpm::api::ParsedJob& job) {
+// This server's calibration and threads per job. A spec is parsed with it,
+// so the one estimate of a request (ParsedJob::cost) is what the limits are
+// checked against and what the 201, /validate and GET /jobs/{id} show.
+hmpm::api::Calibration server_calibration(const Context& c) {
   hmpm::api::Calibration calibration;
   if (c.config.seconds_per_particle_step > 0) {
     calibration.seconds_per_particle_step = c.config.seconds_per_particle_step;
     calibration.measured = true;
   }
   calibration.threads = std::max(c.config.threads_per_job, 1);
-  return hmpm::api::estimate_cost(job.problem, calibration);
+  return calibration;
 }
 
 // The cost document with the wall-time estimate of every scheme, from
 // this server's calibration (POST /validate and the 201 of POST /jobs).
-Json cost_with_estimate(const Context& c, const hmpm::api::ParsedJob& job) {
-  const hmpm::api::CostEstimate cost = server_estimate(c, job);
+Json cost_with_estimate(const hmpm::api::CostEstimate& cost) {
   const hmpm::api::Calibration& calibration = cost.calibration;
   Json doc = cost_document(cost_of(cost));
   doc["threads"] = cost.threads;
@@ -200,10 +200,10 @@ void submit_job(Context& c, const httplib::Request& req, httplib::Response& res,
   {
     const ValidationGate::Turn turn = c.validation.enter();
     if (!turn) return send_validation_busy(c, res);
-    parsed = hmpm::api::parse_job(spec, c.limits);
+    parsed = hmpm::api::parse_job(spec, c.limits, server_calibration(c));
   }
   if (!parsed.ok() || !parsed.job) return send_invalid_spec(res, parsed.errors);
-  const hmpm::api::CostEstimate estimate = server_estimate(c, *parsed.job);
+  const hmpm::api::CostEstimate& estimate = parsed.job->cost;
   if (refuse_over_limits(c, res, estimate)) return;
 
   NewJob job;
@@ -218,7 +218,7 @@ void submit_job(Context& c, const httplib::Request& req, httplib::Response& res,
   // the run's summary.json repeats them.
   const auto accepted_document = [&] {
     Json doc = status_document(submitted.job);
-    doc["cost"] = cost_with_estimate(c, *parsed.job);
+    doc["cost"] = cost_with_estimate(estimate);
     if (!parsed.job->warnings.empty()) doc["warnings"] = spec_issues(parsed.job->warnings);
     return doc;
   };
@@ -311,16 +311,16 @@ void validate_spec(Context& c, const httplib::Request&, httplib::Response& res,
   {
     const ValidationGate::Turn turn = c.validation.enter();
     if (!turn) return send_validation_busy(c, res);
-    parsed = hmpm::api::parse_job(body, c.limits);
+    parsed = hmpm::api::parse_job(body, c.limits, server_calibration(c));
   }
   if (!parsed.ok() || !parsed.job) return send_invalid_spec(res, parsed.errors);
   // A spec over a limit of this server is valid but would be refused: said
   // here as POST /jobs would say it.
-  if (refuse_over_limits(c, res, server_estimate(c, *parsed.job))) return;
+  if (refuse_over_limits(c, res, parsed.job->cost)) return;
   send_json(res, 200,
             Json{{"valid", true},
                  {"warnings", spec_issues(parsed.job->warnings)},
-                 {"cost", cost_with_estimate(c, *parsed.job)}});
+                 {"cost", cost_with_estimate(parsed.job->cost)}});
 }
 
 void get_job(Context& c, const httplib::Request& req, httplib::Response& res) {
@@ -329,9 +329,10 @@ void get_job(Context& c, const httplib::Request& req, httplib::Response& res) {
   Json doc = status_document(*job);
   // The spec's warnings, as in the 201: the stored spec parsed again (the
   // same bytes give the same warnings), so the store keeps no copy of them.
-  const hmpm::api::ParseResult parsed = hmpm::api::parse_job(job->spec, c.limits);
+  const hmpm::api::ParseResult parsed =
+      hmpm::api::parse_job(job->spec, c.limits, server_calibration(c));
   doc["warnings"] = parsed.job ? spec_issues(parsed.job->warnings) : Json::array();
-  if (parsed.job) doc["cost"] = cost_with_estimate(c, *parsed.job);
+  if (parsed.job) doc["cost"] = cost_with_estimate(parsed.job->cost);
   send_json(res, 200, doc);
 }
 
@@ -348,7 +349,7 @@ void get_job_log(Context& c, const httplib::Request& req, httplib::Response& res
     return send_problem(res, 410, "job-dismissed", "Job dismissed",
                         "the job was deleted; its log went with its results");
   }
-  std::ifstream in(c.workers.job_dir(job->id) / run_log_name, std::ios::binary);
+  std::ifstream in(c.files.log_file(job->id), std::ios::binary);
   std::ostringstream text;
   if (in) text << in.rdbuf();  // no file yet: the job has not started
   res.set_content(text.str(), "text/plain; charset=utf-8");
@@ -366,7 +367,7 @@ void cancel_job(Context& c, const httplib::Request& req, httplib::Response& res)
                             "); nothing was changed",
                         Json{{"jobID", id}, {"jobStatus", status_name(before->status)}});
   }
-  append_run_log(c.workers.job_dir(id),
+  append_run_log(c.files.job_dir(id),
                  std::string("cancelled by the client while ") + status_name(before->status));
   log_dismissal(id, before->status, "cancel");
   // A worker of this process records the files written so far; give it a
@@ -384,10 +385,7 @@ void dismiss_job(Context& c, const httplib::Request& req, httplib::Response& res
   const auto before = c.store.dismiss(id);
   if (!before) return send_no_such_job(res, id);
   // A worker of this process removes the files itself once it has stopped.
-  if (!c.workers.cancel(id) && !before->results_deleted) {
-    std::error_code ec;
-    std::filesystem::remove_all(c.workers.job_dir(id), ec);
-  }
+  if (!c.workers.cancel(id) && !before->results_deleted) c.files.remove(id);
   if (before->status != JobStatus::dismissed) log_dismissal(id, before->status, "delete");
   const auto after = c.store.find(id);
   if (!after) return send_no_such_job(res, id);

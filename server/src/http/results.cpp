@@ -124,7 +124,7 @@ void get_result_file(Context& c, const httplib::Request& req, httplib::Response&
   }
   if (!file)
     return send_not_found(res, "job " + job->id + " has no result file named '" + name + "'");
-  const auto path = c.workers.results_dir(*job) / file->name;
+  const auto path = c.files.results_dir(*job) / file->name;
   struct stat st {};
   auto in = std::make_shared<std::ifstream>(path, std::ios::binary);
   if (::stat(path.c_str(), &st) != 0 || !*in ||
@@ -143,6 +143,11 @@ void get_result_file(Context& c, const httplib::Request& req, httplib::Response&
     res.status = 304;
     return;
   }
+  // If-Range: the range only if the client's copy is this one (a strong
+  // comparison: a weak tag or a date never matches, as no Last-Modified is
+  // sent); otherwise the whole file.
+  if (req.has_header("If-Range") && req.get_header_value("If-Range") != etag)
+    const_cast<httplib::Request&>(req).ranges.clear();
   bool partial = false;
   const auto span = requested_span(req, size, partial);
   // httplib applies req.ranges to the response itself, without checking them

@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "connection.hpp"
+#include "exposure.hpp"
 #include "handlers.hpp"
 #include "problem.hpp"
 
@@ -40,6 +41,7 @@ std::vector<Route> route_table() {
       {Method::get, job + "/results", Access::token, get_manifest},
       {Method::get, job + "/results/(.+)", Access::token, get_result_file},
       {Method::get, job + "/events", Access::token, stream_events},
+      {Method::get, "/fields", Access::open, get_fields},
       {Method::get, "/ui(/.*)?", Access::open, get_ui},
       // OGC API – Processes (ogc.cpp); its jobs are the /jobs routes above.
       {Method::get,
@@ -157,6 +159,7 @@ void Router::register_route(httplib::Server& server, const Compiled& c) const {
           if (guarded && !auth_.authorized(req)) return auth_.refuse(res);
           if (!query_accepted(route, req, res)) return;
           f(context_, req, res);
+          bound_compression(req, res);
         });
     return;
   }
@@ -195,6 +198,7 @@ void Router::register_route(httplib::Server& server, const Compiled& c) const {
                         if (guarded && !auth_.authorized(req)) return auth_.refuse(res);
                         if (!query_accepted(route, req, res)) return;
                         f(context_, req, res, body);
+                        bound_compression(req, res);
                       });
 }
 

@@ -8,6 +8,7 @@
 #include <optional>
 
 #include "connection.hpp"
+#include "exposure.hpp"
 #include "job_log.hpp"
 #include "problem.hpp"
 
@@ -72,6 +73,9 @@ void answer_unrouted_error(const httplib::Request& req, httplib::Response& res) 
       return send_problem(res, 431, "headers-too-large", "Request header fields too large",
                           "the request line and headers exceed the server's limit of size or "
                           "number of header lines");
+    case StreamLimit::malformed_head:
+      return send_problem(res, 400, "bad-request", "Bad request",
+                          "malformed request head: " + malformed_head_reason());
     case StreamLimit::none:
       break;
   }
@@ -97,12 +101,22 @@ void configure_server(httplib::Server& http, Context& context, const Router& rou
   http.set_tcp_nodelay(true);
   http.set_read_timeout(10);
 
-  http.set_pre_routing_handler([&router, &auth](const httplib::Request& req,
-                                                httplib::Response& res) {
+  http.set_pre_routing_handler([&router, &auth, &config](const httplib::Request& req,
+                                                         httplib::Response& res) {
     request_start = SteadyClock::now();
     request_timed = true;
     note_routed();
     const auto length = content_length(req);
+    if (!host_allowed(req, config)) {
+      if (length.value_or(0) > 0) close_after_response();
+      send_problem(res, 421, "misdirected-request", "Misdirected request",
+                   "this server does not answer to Host '" +
+                       req.get_header_value("Host").substr(0, 100) +
+                       "'; use its address, or start it with --allowed-host NAME");
+      return httplib::Server::HandlerResponse::Handled;
+    }
+    limit_ranges(req);
+    add_cors_headers(req, config, res);
     if (!served_method(req.method)) {
       if (length.value_or(0) > 0) close_after_response();
       not_implemented(res, req.method);
@@ -123,11 +137,27 @@ void configure_server(httplib::Server& http, Context& context, const Router& rou
       send_problem(res, 400, "bad-request", "Bad request", "Content-Length is not a number");
       return httplib::Server::HandlerResponse::Handled;
     }
+    const bool write = body_method || req.method == "DELETE";
+    if (write && !origin_allowed(req, config)) {
+      if (length.value_or(0) > 0) close_after_response();
+      send_problem(res, 403, "cross-origin-refused", "Cross-origin write refused",
+                   "a page from " + req.get_header_value("Origin").substr(0, 100) +
+                       " may not change this server's jobs; start the server with "
+                       "--allowed-origin ORIGIN to allow it");
+      return httplib::Server::HandlerResponse::Handled;
+    }
     // The token is checked before a body is read: a refused body is never
     // read into memory; the connection drains it briefly and closes.
     if (router.needs_token(req.path) && !auth.authorized(req)) {
       if (length.value_or(0) > 0) close_after_response();
       auth.refuse(res);
+      return httplib::Server::HandlerResponse::Handled;
+    }
+    if (body_not_json(req)) {
+      close_after_response();
+      send_problem(res, 415, "unsupported-media-type", "Unsupported media type",
+                   "send the body as JSON with 'Content-Type: application/json' (curl: -H "
+                   "'Content-Type: application/json' --data-binary @spec.json)");
       return httplib::Server::HandlerResponse::Handled;
     }
     return httplib::Server::HandlerResponse::Unhandled;

@@ -1,10 +1,12 @@
 // fields.hpp — the output fields: one table, everything else derives from it.
 //
 // A field is a per-particle quantity the solver can write into a series or
-// a snapshot. `field_table` lists each one with its contract name and its
-// kind; from it derive field_name and field_components (here), the names
-// the job-spec parser accepts, the column and array names the result
-// writers produce, and the JSON Schema check (through `hmpm spec-keys`).
+// a snapshot. `field_table` lists each one with its contract name, its kind
+// and its SI unit; from it derive field_name and field_components (here),
+// the names the job-spec parser accepts, the column and array names the
+// result writers produce, the JSON Schema check (through `hmpm spec-keys`)
+// and the units of the plots (hmpm-server's GET /fields, read by the
+// dashboard and the Python client).
 // To add a field: a Field enumerator, its row in field_table (same order),
 // its Snapshot array in run.hpp and its sampling in the solver.
 #pragma once
@@ -37,22 +39,23 @@ struct FieldInfo {
   Field field;
   std::string_view name;  ///< the contract's name ("pore_pressure", ...)
   FieldKind kind;
+  std::string_view unit;  ///< SI unit of every component ("-": dimensionless)
 };
 
 /// Every field, in the order of the Field enumerators.
 inline constexpr std::array<FieldInfo, 10> field_table{{
-    {Field::position, "position", FieldKind::vector},
-    {Field::displacement, "displacement", FieldKind::vector},
-    {Field::velocity, "velocity", FieldKind::vector},
-    {Field::pore_pressure, "pore_pressure", FieldKind::scalar},
-    {Field::darcy_velocity, "darcy_velocity", FieldKind::vector},
-    {Field::effective_stress, "effective_stress", FieldKind::tensor},
-    {Field::strain, "strain", FieldKind::tensor},
-    {Field::porosity, "porosity", FieldKind::scalar},
-    {Field::total_stress, "total_stress", FieldKind::tensor},
+    {Field::position, "position", FieldKind::vector, "m"},
+    {Field::displacement, "displacement", FieldKind::vector, "m"},
+    {Field::velocity, "velocity", FieldKind::vector, "m/s"},
+    {Field::pore_pressure, "pore_pressure", FieldKind::scalar, "Pa"},
+    {Field::darcy_velocity, "darcy_velocity", FieldKind::vector, "m/s"},
+    {Field::effective_stress, "effective_stress", FieldKind::tensor, "Pa"},
+    {Field::strain, "strain", FieldKind::tensor, "-"},
+    {Field::porosity, "porosity", FieldKind::scalar, "-"},
+    {Field::total_stress, "total_stress", FieldKind::tensor, "Pa"},
     // Accumulated equivalent plastic strain, sum of sqrt(2/3 deps_p : deps_p)
     // over the steps (zero for elastic materials).
-    {Field::plastic_strain, "plastic_strain", FieldKind::scalar},
+    {Field::plastic_strain, "plastic_strain", FieldKind::scalar, "-"},
 }};
 inline constexpr int field_count = static_cast<int>(field_table.size());
 
@@ -64,7 +67,7 @@ constexpr bool field_table_is_in_enum_order() {
 static_assert(field_table_is_in_enum_order(), "field_table rows must follow the Field enumerators");
 
 /// What field_info gives for a value outside the enumerators: "?", one component.
-inline constexpr FieldInfo unknown_field{Field::position, "?", FieldKind::scalar};
+inline constexpr FieldInfo unknown_field{Field::position, "?", FieldKind::scalar, ""};
 
 constexpr const FieldInfo& field_info(Field f) {
   const auto i = static_cast<std::size_t>(f);

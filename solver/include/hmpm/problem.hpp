@@ -303,7 +303,7 @@ struct StepGrowth {
 /// Linear solver of the implicit schemes' sparse systems.
 enum class LinearSolver {
   automatic,  ///< the scheme chooses by size (documented in docs/schemes.md)
-  direct,     ///< sparse Cholesky / LU (Eigen)
+  direct,     ///< sparse Cholesky / LDL^T (symmetric) or LU (SuiteSparse, Eigen)
   iterative,  ///< preconditioned conjugate gradients / BiCGSTAB (Eigen)
 };
 

@@ -1,7 +1,7 @@
 // geometry/polygon.hpp — plane polygons (internal, header only): where a
 // point lies (inside, outside, on the boundary), area, perimeter and the
 // checks that make a polygon simple. Used by the particle layout of polygon
-// and prism bodies and by polygon selections (problem.cpp), so filling and
+// and prism bodies and by polygon selections (problem/layout.cpp), so filling and
 // selecting agree on every point.
 #pragma once
 

@@ -4,14 +4,29 @@
 // One system per time step: the sparsity pattern (which degrees of freedom
 // share a particle stencil) is set once per step, when the particles have
 // moved and the grid has been reset; the values are refilled in that pattern
-// at every Newton iteration (no allocation), and the direct solver's symbolic
-// analysis (fill-reducing ordering) is done once per pattern. Two solvers:
-// Eigen's SparseLU (direct) and BiCGSTAB with an incomplete LU (ILUT)
-// preconditioner (iterative). The matrix is the symmetric indefinite
-// saddle-point Jacobian of schemes/quasi_static_scheme.hpp, scaled so that
-// both blocks have the same size (see there).
+// at every Newton iteration (no allocation). The matrix is the saddle-point
+// Jacobian of schemes/quasi_static_scheme.hpp, scaled so that both blocks
+// have the same size (see there): symmetric quasi-definite for elastic and
+// associated plastic soil, unsymmetric for non-associated plasticity.
+//
+// Direct solves (docs/schemes.md, measurements in docs/performance.md):
+// - symmetric values (checked at every solve, entry against its mirror,
+//   to 1e-10 of the largest entry): an LDL^T factorisation without pivoting
+//   (SuiteSparse's CHOLMOD, simplicial, AMD or METIS ordering), which a
+//   quasi-definite matrix admits in any order; its solution is checked
+//   (residual) and, should the factorisation have failed or be inaccurate
+//   (an indefinite stiffness block, e.g. softening), the LU below is used;
+// - otherwise UMFPACK's LU (SuiteSparse; COLAMD/AMD ordering, partial
+//   pivoting).
+// The symbolic analysis (ordering, elimination tree) is kept while the
+// pattern does not change, across Newton iterations and time steps; the
+// numeric factorisation is kept while the values do not change either (an
+// elastic step's Jacobian is the same at every Newton iteration: its second
+// and later iterations cost a solve, not a factorisation).
+// Iterative solves: BiCGSTAB with an incomplete LU (ILUT) preconditioner.
 #pragma once
 
+#include <Eigen/Core>
 #include <Eigen/SparseCore>
 #include <algorithm>
 #include <cstdint>
@@ -24,9 +39,12 @@ namespace hmpm {
 
 class UpSystem {
  public:
-  /// Unknowns above which LinearSolver::automatic takes the iterative solver
-  /// (docs/schemes.md gives the measurements behind it).
-  static constexpr std::int64_t automatic_iterative_above = 200000;
+  /// Unknowns above which LinearSolver::automatic takes the iterative solver,
+  /// per grid dimension (docs/schemes.md gives the measurements behind it):
+  /// a 2D factor fills in like n log n, a 3D one like n^(4/3) and costs
+  /// n^2 operations.
+  static constexpr std::int64_t automatic_iterative_above_2d = 2000000;
+  static constexpr std::int64_t automatic_iterative_above_3d = 200000;
 
   /// Starts a new pattern of n unknowns (the triplet list keeps its capacity).
   void begin_pattern(std::int64_t n);
@@ -35,8 +53,9 @@ class UpSystem {
     pattern_.emplace_back(static_cast<int>(r), static_cast<int>(c), 0.0);
   }
   /// Compresses the pattern; the solver chosen for `which` (automatic: by
-  /// size) analyses it on the first solve.
-  void finish_pattern(LinearSolver which, double linear_tolerance);
+  /// size and the grid's dimension `dim`) analyses it on the first solve,
+  /// unless it analysed the same pattern before.
+  void finish_pattern(LinearSolver which, double linear_tolerance, int dim = 2);
 
   /// Zeroes the values (pattern kept).
   void zero_values();
@@ -65,17 +84,39 @@ class UpSystem {
   bool iterative() const { return iterative_; }
   const char* error() const { return error_; }
 
+  /// Which factorisation the last direct solve used.
+  enum class Method { none, ldlt, lu, iterative };
+  Method method() const { return method_; }
+
   std::int64_t linear_iterations = 0;  ///< iterative solves: summed iterations
   std::int64_t solves = 0;
-  double factor_seconds = 0.0, solve_seconds = 0.0;  ///< cumulated (benchmarks)
+  // Cumulated, for benchmarks (not saved in checkpoints).
+  std::int64_t analyses = 0, factorisations = 0;  ///< symbolic / numeric
+  double factor_seconds = 0.0, solve_seconds = 0.0;
 
  private:
   struct Solvers;
   Solvers* solvers();
 
+  /// True when the values are symmetric (to 1e-10 of the largest).
+  bool symmetric_values() const;
+  bool solve_ldlt(const Eigen::VectorXd& b, Eigen::VectorXd& x);
+  bool solve_lu(const Eigen::VectorXd& b, Eigen::VectorXd& x);
+  bool solve_iterative(const Eigen::VectorXd& b, Eigen::VectorXd& x);
+
   std::int64_t n_ = 0;
   bool iterative_ = false;
-  bool analysed_ = false;
+  // Whether each solver's symbolic analysis / numeric factorisation belongs
+  // to the current pattern / values.
+  bool ldlt_analysed_ = false, lu_analysed_ = false;
+  Method factored_ = Method::none;  ///< the factor that holds factored_values_
+  Method method_ = Method::none;
+  std::vector<double> factored_values_;
+  // The pattern the factorisations analysed, and each entry's mirror (the
+  // position of (c, r) for entry (r, c); -1: none, the pattern unsymmetric).
+  std::vector<int> analysed_outer_, analysed_inner_;
+  std::vector<std::int64_t> mirror_;
+  bool structurally_symmetric_ = false;
   double tolerance_ = 1e-12;
   const char* error_ = "";
   std::vector<Eigen::Triplet<double>> pattern_;

@@ -288,7 +288,7 @@ class QuasiStaticScheme final : public TimeScheme {
       }
     }
     system_.finish_pattern(c_.model.problem.time.implicit.linear_solver,
-                           c_.model.problem.time.implicit.linear_tolerance);
+                           c_.model.problem.time.implicit.linear_tolerance, Dim);
     rhs_.resize(unknowns_);
     ref_.resize(unknowns_);
     // Private sums of threads 1.. (zero between assemblies; no allocation

@@ -115,6 +115,8 @@ struct ParsedJob {
   std::string name;
   hmpm::Problem problem;
   std::vector<ProfileGeometry> profiles;  ///< one per problem.output.profiles line
+  /// The estimate the limits were checked against, with parse_job's
+  /// calibration (the one estimate of a parse).
   CostEstimate cost;
   /// Runnable, but worth knowing before running (hmpm::problem_warnings),
   /// with JSON pointers like errors; the run's summary repeats them.
@@ -127,8 +129,10 @@ struct ParseResult {
   bool ok() const { return errors.empty(); }
 };
 
-/// Parses, validates and converts a job spec. Never throws.
-ParseResult parse_job(std::string_view json_text, const Limits& limits = {});
+/// Parses, validates and converts a job spec. Never throws. The cost is
+/// estimated once, with `calibration` (ParsedJob::cost).
+ParseResult parse_job(std::string_view json_text, const Limits& limits = {},
+                      const Calibration& calibration = {});
 
 /// The result files of one run, as written into a directory.
 struct JobOutcome {

@@ -29,8 +29,10 @@ struct ServiceConfig {
   /// Result files; empty: <db dir>/results (SQLite only). With PostgreSQL it
   /// is shared by every server on the database, and not locked.
   std::filesystem::path data_dir;
-  int workers = 1;          ///< jobs run at the same time
-  int threads_per_job = 0;  ///< solver threads per job; <= 0: cores / workers
+  /// Jobs run at the same time. Two by default: a long job never holds the
+  /// queue, a short one submitted meanwhile runs beside it (issue 44).
+  int workers = 2;
+  int threads_per_job = 0;  ///< solver threads per job; <= 0: cores / workers (at least 1)
   std::string token;        ///< non-empty: Bearer token required (not on /health)
   long max_queue = 1000;    ///< accepted jobs before POST /jobs answers 503
   /// Per-job wall-clock limit, set-up included; <= 0: none.
@@ -54,6 +56,12 @@ struct ServiceConfig {
   double body_timeout_s = 60.0;       ///< a request's body must arrive within this
   double event_stream_max_s = 300.0;  ///< an event stream ends after this; the client reconnects
   bool allow_no_token = false;  ///< a non-loopback --host without a token starts (with a warning)
+  /// Host header values accepted besides the listening address (NAME, any
+  /// port, or NAME:PORT): the names clients and proxies reach the server by.
+  std::vector<std::string> allowed_hosts;
+  /// Origins (scheme://host[:port]) whose pages may write (POST, DELETE...)
+  /// and get CORS headers; the server's own origin needs no entry.
+  std::vector<std::string> allowed_origins;
   double progress_interval_s = 1.0;    ///< how often a running job's progress is stored
   double heartbeat_interval_s = 10.0;  ///< SSE comment line when nothing else was sent
   double lease_s = 30.0;  ///< a running job's claim lapses this long after its last renewal

@@ -69,6 +69,20 @@ struct JobCost {
   double dt = 0.0;  ///< s
 };
 
+/// What a job's run reached, as its worker reports it (zeros until it runs):
+/// the solver's own simulated time and end time, the steps taken and the
+/// range of the time step. dt_min/dt_max are the smallest and largest mean
+/// step over the intervals between progress reports (and over the whole run
+/// at the end), so a single cut-back shorter than one report is averaged in.
+struct RunProgress {
+  double percent = 0.0;    ///< 0..100 of simulated time
+  double time = 0.0;       ///< simulated time reached, s
+  double end_time = 0.0;   ///< the run's end time, s (0: not known)
+  std::int64_t steps = 0;  ///< time steps taken
+  double dt_min = 0.0;     ///< s (0: not known)
+  double dt_max = 0.0;     ///< s
+};
+
 /// One row of the jobs table. Timestamps are RFC 3339 UTC; empty = not yet.
 struct JobRecord {
   std::string id;
@@ -77,6 +91,10 @@ struct JobRecord {
   std::string spec;
   JobStatus status = JobStatus::accepted;
   double progress = 0.0;  ///< percent, 0..100
+  RunProgress run;        ///< what the run reached (run.percent == progress)
+  /// Accepted jobs: 1 for the next one a worker takes, 2 for the one after…
+  /// (0 for any other status).
+  std::int64_t queue_position = 0;
   std::string message;
   std::string created;
   std::string started;
@@ -169,6 +187,8 @@ struct JobEnd {
   std::string failure_reason;  ///< empty when successful
   std::vector<ResultFile> files;
   double run_seconds = 0.0;
+  /// What the run reached (all zeros: keep what the last progress stored).
+  RunProgress run;
 };
 
 /// A running job's last checkpoint: the solver state after `step`, in
@@ -214,8 +234,15 @@ class JobStore {
   /// Returns how many leases were renewed.
   virtual std::int64_t renew_leases(const Claimant& who) = 0;
 
-  /// Sets the progress (percent) of a running job.
-  virtual ClaimState update_progress(const Claim& claim, double percent) = 0;
+  /// Sets what a running job's run reached (its progress percent, simulated
+  /// time, steps and step range).
+  virtual ClaimState record_progress(const Claim& claim, const RunProgress& run) = 0;
+  /// Sets the progress (percent) of a running job alone.
+  ClaimState update_progress(const Claim& claim, double percent) {
+    RunProgress run;
+    run.percent = percent;
+    return record_progress(claim, run);
+  }
 
   /// Ends a running job as successful or failed with its result files.
   /// Records nothing unless the claim is held.

@@ -13,6 +13,7 @@
 
 #include "clock.hpp"
 #include "migrate.hpp"
+#include "store/recovery.hpp"
 
 namespace hmpm::server::postgres {
 namespace {
@@ -30,12 +31,22 @@ const std::string ended_statuses = "(" + sql_name(JobStatus::successful) + "," +
 // and the idempotency-key check hold across servers ("hmpn" in ASCII).
 constexpr const char* submit_lock = "SELECT pg_advisory_xact_lock(1752001902)";
 
-constexpr const char* job_columns =
+// The last column is an accepted job's place in the queue (1: next); in a
+// RETURNING clause the subquery sees the rows as they were before.
+const std::string job_columns =
     "id, seq, name, spec, status, progress, message, created, coalesce(started, ''), "
     "coalesce(finished, ''), updated, attempts, coalesce(failure_reason, ''), cost_particles, "
     "cost_nodes, cost_cells, cost_steps, cost_particle_steps, cost_memory_bytes, "
     "cost_output_bytes, cost_dt, run_seconds, coalesce(owner, ''), lease_token, "
-    "lease_expires_ms, results_deleted";
+    "lease_expires_ms, results_deleted, run_time, run_end_time, run_steps, run_dt_min, "
+    "run_dt_max, CASE WHEN jobs.status = " +
+    sql_name(JobStatus::accepted) +
+    " THEN 1 + (SELECT count(*) FROM jobs AS ahead WHERE ahead.status = " +
+    sql_name(JobStatus::accepted) + " AND ahead.seq < jobs.seq) ELSE 0 END";
+
+// Forgets what an earlier attempt's run reached (part of an UPDATE's SET).
+constexpr const char* no_run =
+    "run_time = 0, run_end_time = 0, run_steps = 0, run_dt_min = 0, run_dt_max = 0, ";
 
 // Clears the checkpoint of a job that ends (part of an UPDATE's SET).
 constexpr const char* no_checkpoint =
@@ -71,15 +82,21 @@ JobRecord read_job(const Result& r, int row) {
   job.owner = text();
   job.lease_token = integer();
   job.lease_expires_ms = integer();
-  job.results_deleted = r.boolean(row, c);
+  job.results_deleted = r.boolean(row, c++);
+  job.run.percent = job.progress;
+  job.run.time = real();
+  job.run.end_time = real();
+  job.run.steps = integer();
+  job.run.dt_min = real();
+  job.run.dt_max = real();
+  job.queue_position = integer();
   return job;
 }
 
 std::optional<JobRecord> select_job(PGconn* db, const std::string& id, bool for_update = false) {
-  const Result r = exec(db,
-                        std::string("SELECT ") + job_columns + " FROM jobs WHERE id = $1" +
-                            (for_update ? " FOR UPDATE" : ""),
-                        Params().add(id));
+  const Result r = exec(
+      db, "SELECT " + job_columns + " FROM jobs WHERE id = $1" + (for_update ? " FOR UPDATE" : ""),
+      Params().add(id));
   if (r.rows() == 0) return std::nullopt;
   return read_job(r, 0);
 }
@@ -199,8 +216,7 @@ std::optional<JobRecord> PostgresStore::find(const std::string& id) {
 
 std::vector<JobRecord> PostgresStore::list(const std::vector<JobStatus>& statuses,
                                            const std::string& name, int limit) {
-  std::string sql =
-      std::string("SELECT ") + job_columns + " FROM jobs WHERE ($2 = '' OR name = $2)";
+  std::string sql = "SELECT " + job_columns + " FROM jobs WHERE ($2 = '' OR name = $2)";
   if (!statuses.empty()) {
     sql += " AND status IN (";
     for (std::size_t i = 0; i < statuses.size(); ++i) {
@@ -237,16 +253,16 @@ std::optional<JobRecord> PostgresStore::claim_next(const Claimant& who) {
   const std::string now = now_text();
   // SKIP LOCKED: a row another server is claiming right now is passed over,
   // not waited for; the next accepted one is taken instead.
-  const Result r =
-      exec(db,
-           "UPDATE jobs SET status = " + sql_name(JobStatus::running) +
-               ", progress = 0, message = 'running', started = $1, finished = NULL, updated = $1, "
-               "attempts = attempts + 1, owner = $2, lease_token = lease_token + 1, "
-               "lease_expires_ms = $3, claimed_ms = $4, alive_ms = $4 WHERE id = (SELECT id FROM "
-               "jobs WHERE status = " +
-               sql_name(JobStatus::accepted) +
-               " ORDER BY seq LIMIT 1 FOR UPDATE SKIP LOCKED) RETURNING " + job_columns,
-           Params().add(now).add(who.instance).add(lease_until(who)).add(now_ms()));
+  const Result r = exec(
+      db,
+      "UPDATE jobs SET status = " + sql_name(JobStatus::running) + ", progress = 0, " + no_run +
+          "message = 'running', started = $1, finished = NULL, updated = $1, "
+          "attempts = attempts + 1, owner = $2, lease_token = lease_token + 1, "
+          "lease_expires_ms = $3, claimed_ms = $4, alive_ms = $4 WHERE id = (SELECT id FROM "
+          "jobs WHERE status = " +
+          sql_name(JobStatus::accepted) +
+          " ORDER BY seq LIMIT 1 FOR UPDATE SKIP LOCKED) RETURNING " + job_columns,
+      Params().add(now).add(who.instance).add(lease_until(who)).add(now_ms()));
   if (r.rows() == 0) return std::nullopt;
   JobRecord job = read_job(r, 0);
   exec(db, "INSERT INTO job_attempts (job_id, token, owner, claimed) VALUES ($1, $2, $3, $4)",
@@ -265,12 +281,19 @@ std::int64_t PostgresStore::renew_leases(const Claimant& who) {
       .affected();
 }
 
-ClaimState PostgresStore::update_progress(const Claim& claim, double percent) {
+ClaimState PostgresStore::record_progress(const Claim& claim, const RunProgress& run) {
   auto connection = pool_.lease();
   PGconn* db = connection.get();
+  Params p = claim_params(claim);
+  p.add(run.percent).add(now_text()).add(now_ms()).add(run.time).add(run.end_time);
+  p.add(run.steps).add(run.dt_min).add(run.dt_max);
   const Result r =
-      exec(db, "UPDATE jobs SET progress = $4, updated = $5, alive_ms = $6 WHERE " + claim_held,
-           claim_params(claim).add(percent).add(now_text()).add(now_ms()));
+      exec(db,
+           "UPDATE jobs SET progress = $4, updated = $5, alive_ms = $6, run_time = $7, "
+           "run_end_time = $8, run_steps = $9, run_dt_min = $10, run_dt_max = $11 "
+           "WHERE " +
+               claim_held,
+           p);
   return r.affected() == 1 ? ClaimState::held : claim_state(db, claim);
 }
 
@@ -281,14 +304,20 @@ ClaimState PostgresStore::finish(const Claim& claim, const JobEnd& end) {
   const std::string now = now_text();
   Params p = claim_params(claim);
   p.add(status_name(end.status)).add(end.message).add_or_null(end.failure_reason).add(now);
-  p.add(end.run_seconds);
-  const Result r =
-      exec(db,
-           "UPDATE jobs SET status = $4, message = $5, failure_reason = $6, finished = $7, "
-           "updated = $7, run_seconds = $8, progress = CASE WHEN $4 = " +
-               sql_name(JobStatus::successful) + " THEN 100 ELSE progress END, " + no_checkpoint +
-               " WHERE " + claim_held,
-           p);
+  p.add(end.run_seconds).add(end.run.steps).add(end.run.time).add(end.run.end_time);
+  p.add(end.run.dt_min).add(end.run.dt_max);
+  const Result r = exec(
+      db,
+      "UPDATE jobs SET status = $4, message = $5, failure_reason = $6, finished = $7, "
+      "updated = $7, run_seconds = $8, progress = CASE WHEN $4 = " +
+          sql_name(JobStatus::successful) +
+          " THEN 100 ELSE progress END, run_time = CASE WHEN $9::bigint > 0 THEN $10 ELSE run_time "
+          "END, run_end_time = CASE WHEN $9 > 0 THEN $11 ELSE run_end_time END, run_steps = "
+          "CASE WHEN $9 > 0 THEN $9 ELSE run_steps END, run_dt_min = CASE WHEN $9 > 0 THEN "
+          "$12 ELSE run_dt_min END, run_dt_max = CASE WHEN $9 > 0 THEN $13 ELSE run_dt_max "
+          "END, " +
+          no_checkpoint + " WHERE " + claim_held,
+      p);
   if (r.affected() != 1) return claim_state(db, claim);
   replace_results(db, claim.job_id, end.files);
   end_attempt(db, claim, status_name(end.status), now);
@@ -304,12 +333,12 @@ ClaimState PostgresStore::requeue(const Claim& claim) {
   // The checkpoint stays: the next claim resumes from it.
   const Result r = exec(db,
                         "UPDATE jobs SET status = " + sql_name(JobStatus::accepted) +
-                            ", progress = 0, started = NULL, "
-                            "message = 'queued again: the server stopped while it ran', "
+                            ", progress = 0, " + no_run +
+                            "started = NULL, message = $5, "
                             "updated = $4, attempts = greatest(attempts - 1, 0), "
                             "lease_expires_ms = 0 WHERE " +
                             claim_held,
-                        claim_params(claim).add(now));
+                        claim_params(claim).add(now).add(requeued_message));
   if (r.affected() != 1) return claim_state(db, claim);
   end_attempt(db, claim, "requeued", now);
   tx.commit();
@@ -401,27 +430,15 @@ RecoveryReport PostgresStore::recover(int max_attempts, double charge_after_s) {
   const std::string now = now_text();
   for (int i = 0; i < lapsed.rows(); ++i) {
     const std::string id = lapsed.text(i, 0);
-    const auto attempts = lapsed.integer(i, 1);
-    // Charged only when the attempt had run long enough to be the suspect
-    // (the rule of the SQLite store; store.hpp, recover).
-    const double ran_s = static_cast<double>(lapsed.integer(i, 3)) / 1000.0;
-    const auto charged = lapsed.integer(i, 2) + (ran_s >= charge_after_s ? 1 : 0);
-    std::string reason;
-    if (charged >= max_attempts) {
-      reason = "the server stopped " + std::to_string(charged) +
-               " times while this job ran (limit " + std::to_string(max_attempts) +
-               " attempts); not retried";
-    } else if (attempts >= std::int64_t{uncharged_start_factor} * max_attempts) {
-      reason = "this job was started " + std::to_string(attempts) +
-               " times and the server stopped every time (limit " +
-               std::to_string(uncharged_start_factor * max_attempts) + " starts); not retried";
-    }
+    const auto [charged, reason] =
+        decide_recovery({lapsed.integer(i, 1), lapsed.integer(i, 2),
+                         static_cast<double>(lapsed.integer(i, 3)) / 1000.0},
+                        max_attempts, charge_after_s);
     if (reason.empty()) {
       exec(db,
-           "UPDATE jobs SET status = " + sql_name(JobStatus::accepted) +
-               ", progress = 0, started = NULL, updated = $1, charged = $3, "
-               "message = 'queued again: the server stopped while it ran' WHERE id = $2",
-           Params().add(now).add(id).add(charged));
+           "UPDATE jobs SET status = " + sql_name(JobStatus::accepted) + ", progress = 0, " +
+               no_run + "started = NULL, updated = $1, charged = $3, message = $4 WHERE id = $2",
+           Params().add(now).add(id).add(charged).add(requeued_message));
       report.requeued.push_back(id);
     } else {
       exec(db,

@@ -12,6 +12,7 @@
 
 #include "clock.hpp"
 #include "migrate.hpp"
+#include "store/recovery.hpp"
 
 namespace hmpm::server::sqlite {
 namespace {
@@ -21,11 +22,20 @@ std::string sql_name(JobStatus status) {
   return std::string("'") + status_name(status) + "'";
 }
 
-constexpr const char* job_columns =
+// Forgets what an earlier attempt's run reached (part of an UPDATE's SET).
+constexpr const char* no_run =
+    "run_time = 0, run_end_time = 0, run_steps = 0, run_dt_min = 0, run_dt_max = 0, ";
+
+// The last column is an accepted job's place in the queue (1: next).
+const std::string job_columns =
     "id, seq, name, spec, status, progress, message, created, started, finished, updated, "
     "attempts, failure_reason, cost_particles, cost_nodes, cost_cells, cost_steps, "
     "cost_particle_steps, cost_memory_bytes, cost_output_bytes, cost_dt, run_seconds, "
-    "coalesce(owner, ''), lease_token, lease_expires_ms, results_deleted";
+    "coalesce(owner, ''), lease_token, lease_expires_ms, results_deleted, run_time, "
+    "run_end_time, run_steps, run_dt_min, run_dt_max, CASE WHEN status = " +
+    sql_name(JobStatus::accepted) +
+    " THEN 1 + (SELECT count(*) FROM jobs AS ahead WHERE ahead.status = " +
+    sql_name(JobStatus::accepted) + " AND ahead.seq < jobs.seq) ELSE 0 END";
 
 JobRecord read_job(const Statement& s) {
   JobRecord r;
@@ -55,11 +65,18 @@ JobRecord read_job(const Statement& s) {
   r.lease_token = s.integer(23);
   r.lease_expires_ms = s.integer(24);
   r.results_deleted = s.integer(25) != 0;
+  r.run.percent = r.progress;
+  r.run.time = s.real(26);
+  r.run.end_time = s.real(27);
+  r.run.steps = s.integer(28);
+  r.run.dt_min = s.real(29);
+  r.run.dt_max = s.real(30);
+  r.queue_position = s.integer(31);
   return r;
 }
 
 std::optional<JobRecord> select_job(sqlite3* db, std::string_view key) {
-  Statement s(db, std::string("SELECT ") + job_columns + " FROM jobs WHERE id = ?1");
+  Statement s(db, "SELECT " + job_columns + " FROM jobs WHERE id = ?1");
   s.bind(1, key);
   if (!s.step()) return std::nullopt;
   return read_job(s);
@@ -100,13 +117,6 @@ void insert_results(sqlite3* db, const std::string& id, const std::vector<Result
     s.bind(1, id).bind(2, f.name).bind(3, f.size).bind(4, f.sha256).bind(5, f.media_type);
     s.step();
   }
-}
-
-// "30 s", "1.5 s".
-std::string short_duration(double seconds) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%g s", seconds);
-  return text;
 }
 
 }  // namespace
@@ -275,8 +285,7 @@ std::optional<JobRecord> SqliteStore::find(const std::string& id) {
 
 std::vector<JobRecord> SqliteStore::list(const std::vector<JobStatus>& statuses,
                                          const std::string& name, int limit) {
-  std::string sql =
-      std::string("SELECT ") + job_columns + " FROM jobs WHERE (?2 = '' OR name = ?2)";
+  std::string sql = "SELECT " + job_columns + " FROM jobs WHERE (?2 = '' OR name = ?2)";
   if (!statuses.empty()) {
     sql += " AND status IN (";
     for (std::size_t i = 0; i < statuses.size(); ++i) {
@@ -317,8 +326,9 @@ std::optional<JobRecord> SqliteStore::claim_next(const Claimant& who) {
     id = s.text(0);
   }
   const std::string now = now_text();
-  Statement s(db, "UPDATE jobs SET status = " + sql_name(JobStatus::running) +
-                      ", progress = 0, message = 'running', started = ?1, finished = NULL, "
+  Statement s(db, "UPDATE jobs SET status = " + sql_name(JobStatus::running) + ", progress = 0, " +
+                      no_run +
+                      "message = 'running', started = ?1, finished = NULL, "
                       "updated = ?1, attempts = attempts + 1, owner = ?3, "
                       "lease_token = lease_token + 1, lease_expires_ms = ?4, claimed_ms = ?5, "
                       "alive_ms = ?5 WHERE id = ?2");
@@ -343,13 +353,17 @@ std::int64_t SqliteStore::renew_leases(const Claimant& who) {
   return renewed;
 }
 
-ClaimState SqliteStore::update_progress(const Claim& claim, double percent) {
+ClaimState SqliteStore::record_progress(const Claim& claim, const RunProgress& run) {
   auto connection = pool_.lease();
   sqlite3* db = connection.get();
   WriteTransaction tx(db);
-  Statement s(db, "UPDATE jobs SET progress = ?4, updated = ?5, alive_ms = ?6 WHERE " + claim_held);
+  Statement s(db,
+              "UPDATE jobs SET progress = ?4, updated = ?5, alive_ms = ?6, run_time = ?7, "
+              "run_end_time = ?8, run_steps = ?9, run_dt_min = ?10, run_dt_max = ?11 WHERE " +
+                  claim_held);
   bind_claim(s, claim);
-  s.bind(4, percent).bind(5, now_text()).bind(6, now_ms());
+  s.bind(4, run.percent).bind(5, now_text()).bind(6, now_ms()).bind(7, run.time);
+  s.bind(8, run.end_time).bind(9, run.steps).bind(10, run.dt_min).bind(11, run.dt_max);
   s.step();
   const ClaimState state = sqlite3_changes(db) == 1 ? ClaimState::held : claim_state(db, claim);
   tx.commit();
@@ -365,11 +379,17 @@ ClaimState SqliteStore::finish(const Claim& claim, const JobEnd& end) {
     Statement s(db,
                 "UPDATE jobs SET status = ?4, message = ?5, failure_reason = ?6, finished = ?7, "
                 "updated = ?7, run_seconds = ?8, progress = CASE WHEN ?4 = " +
-                    sql_name(JobStatus::successful) + " THEN 100 ELSE progress END WHERE " +
+                    sql_name(JobStatus::successful) +
+                    " THEN 100 ELSE progress END, run_time = CASE WHEN ?9 > 0 THEN ?10 ELSE "
+                    "run_time END, run_end_time = CASE WHEN ?9 > 0 THEN ?11 ELSE run_end_time "
+                    "END, run_steps = CASE WHEN ?9 > 0 THEN ?9 ELSE run_steps END, run_dt_min = "
+                    "CASE WHEN ?9 > 0 THEN ?12 ELSE run_dt_min END, run_dt_max = CASE WHEN ?9 > 0 "
+                    "THEN ?13 ELSE run_dt_max END WHERE " +
                     claim_held);
     bind_claim(s, claim);
     s.bind(4, status_name(end.status)).bind(5, end.message).bind_or_null(6, end.failure_reason);
-    s.bind(7, now).bind(8, end.run_seconds);
+    s.bind(7, now).bind(8, end.run_seconds).bind(9, end.run.steps).bind(10, end.run.time);
+    s.bind(11, end.run.end_time).bind(12, end.run.dt_min).bind(13, end.run.dt_max);
     s.step();
     if (sqlite3_changes(db) != 1) return claim_state(db, claim);
   }
@@ -384,13 +404,13 @@ ClaimState SqliteStore::requeue(const Claim& claim) {
   auto connection = pool_.lease();
   sqlite3* db = connection.get();
   WriteTransaction tx(db);
-  Statement s(db, "UPDATE jobs SET status = " + sql_name(JobStatus::accepted) +
-                      ", progress = 0, started = NULL, "
-                      "message = 'queued again: the server stopped while it ran', updated = ?4, "
+  Statement s(db, "UPDATE jobs SET status = " + sql_name(JobStatus::accepted) + ", progress = 0, " +
+                      no_run +
+                      "started = NULL, message = ?5, updated = ?4, "
                       "attempts = max(attempts - 1, 0), lease_expires_ms = 0 WHERE " +
                       claim_held);
   bind_claim(s, claim);
-  s.bind(4, now_text());
+  s.bind(4, now_text()).bind(5, requeued_message);
   s.step();
   const ClaimState state = sqlite3_changes(db) == 1 ? ClaimState::held : claim_state(db, claim);
   tx.commit();
@@ -470,57 +490,36 @@ RecoveryReport SqliteStore::recover(int max_attempts, double charge_after_s) {
   auto connection = pool_.lease();
   sqlite3* db = connection.get();
   WriteTransaction tx(db);
-  struct Lapsed {
-    std::string id;
-    int attempts = 0;
-    int charged = 0;
-    double ran_s = 0.0;  ///< claim to last proof of life
-  };
-  std::vector<Lapsed> lapsed;
+  std::vector<std::pair<std::string, LapsedAttempt>> lapsed;
   {
     Statement s(db,
                 "SELECT id, attempts, charged, alive_ms - claimed_ms FROM jobs WHERE status = " +
                     sql_name(JobStatus::running) + " AND lease_expires_ms <= ?1 ORDER BY seq");
     s.bind(1, now_ms());
     while (s.step()) {
-      lapsed.push_back({s.text(0), static_cast<int>(s.integer(1)), static_cast<int>(s.integer(2)),
-                        static_cast<double>(s.integer(3)) / 1000.0});
+      lapsed.emplace_back(s.text(0), LapsedAttempt{s.integer(1), s.integer(2),
+                                                   static_cast<double>(s.integer(3)) / 1000.0});
     }
   }
   RecoveryReport report;
   const std::string now = now_text();
-  for (const Lapsed& job : lapsed) {
-    // Charged only when the attempt had run long enough to be the suspect;
-    // a job claimed just before an unrelated crash is not.
-    const int charged = job.charged + (job.ran_s >= charge_after_s ? 1 : 0);
-    std::string reason;
-    if (charged >= max_attempts) {
-      reason = "the server stopped " + std::to_string(charged) +
-               " times while this job ran (each time after at least " +
-               short_duration(charge_after_s) + " of its attempt; limit " +
-               std::to_string(max_attempts) + " attempts); not retried";
-    } else if (job.attempts >= uncharged_start_factor * max_attempts) {
-      reason = "this job was started " + std::to_string(job.attempts) +
-               " times and the server stopped every time, mostly within " +
-               short_duration(charge_after_s) + " of the start (limit " +
-               std::to_string(uncharged_start_factor * max_attempts) + " starts); not retried";
-    }
+  for (const auto& [id, attempt] : lapsed) {
+    const auto [charged, reason] = decide_recovery(attempt, max_attempts, charge_after_s);
     if (reason.empty()) {
-      Statement s(db,
-                  "UPDATE jobs SET status = " + sql_name(JobStatus::accepted) +
-                      ", progress = 0, started = NULL, updated = ?1, charged = ?3, "
-                      "message = 'queued again: the server stopped while it ran' WHERE id = ?2");
-      s.bind(1, now).bind(2, job.id).bind(3, static_cast<std::int64_t>(charged));
+      Statement s(db, "UPDATE jobs SET status = " + sql_name(JobStatus::accepted) +
+                          ", progress = 0, " + no_run +
+                          "started = NULL, updated = ?1, charged = ?3, message = ?4 WHERE id = ?2");
+      s.bind(1, now).bind(2, id).bind(3, charged).bind(4, requeued_message);
       s.step();
-      report.requeued.push_back(job.id);
+      report.requeued.push_back(id);
     } else {
       Statement s(db, "UPDATE jobs SET status = " + sql_name(JobStatus::failed) +
                           ", message = ?1, failure_reason = ?1, finished = ?2, updated = ?2, "
                           "charged = ?4 WHERE id = ?3");
-      s.bind(1, reason).bind(2, now).bind(3, job.id).bind(4, static_cast<std::int64_t>(charged));
+      s.bind(1, reason).bind(2, now).bind(3, id).bind(4, charged);
       s.step();
-      clear_checkpoint(db, job.id);
-      report.failed.push_back(job.id);
+      clear_checkpoint(db, id);
+      report.failed.push_back(id);
     }
   }
   tx.commit();

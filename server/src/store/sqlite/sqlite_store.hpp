@@ -33,7 +33,7 @@ class SqliteStore final : public JobStore {
   std::vector<std::string> ids_with_prefix(const std::string& prefix, int limit) override;
   std::optional<JobRecord> claim_next(const Claimant& who) override;
   std::int64_t renew_leases(const Claimant& who) override;
-  ClaimState update_progress(const Claim& claim, double percent) override;
+  ClaimState record_progress(const Claim& claim, const RunProgress& run) override;
   ClaimState finish(const Claim& claim, const JobEnd& end) override;
   ClaimState requeue(const Claim& claim) override;
   std::optional<JobRecord> cancel(const std::string& id) override;

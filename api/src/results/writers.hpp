@@ -1,40 +1,28 @@
-// writers.hpp — the contract's result files, written atomically.
+// results/writers.hpp — the contract's result files, written atomically.
 //
 // Every writer streams into "<name>.tmp" in the target directory and renames
 // it into place when complete, so a reader (the service, a user watching the
 // directory) never sees a half-written file. Snapshots are written one at a
 // time as the solver hands them over; nothing keeps them in memory.
 // All writers throw std::runtime_error when a file cannot be written.
+//
+// One file per format in results/: summary.cpp (built as nlohmann's
+// ordered_json), series.cpp, profiles.cpp, consolidation.cpp,
+// reactions.cpp (JSON and CSV each, streamed: their arrays can hold
+// millions of numbers; names are escaped by nlohmann, numbers written by
+// hmpm/format.hpp), vtu.cpp (snapshots and the .pvd) and atomic_file.cpp.
 #pragma once
 
 #include <filesystem>
-#include <fstream>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include "hmpm/api/job.hpp"
 #include "hmpm/run.hpp"
+#include "results/atomic_file.hpp"
 
 namespace hmpm::api {
-
-/// A file that appears under its final name only when commit() succeeds;
-/// destroyed uncommitted, it removes its temporary file.
-class AtomicFile {
- public:
-  explicit AtomicFile(std::filesystem::path path);
-  ~AtomicFile();
-  AtomicFile(const AtomicFile&) = delete;
-  AtomicFile& operator=(const AtomicFile&) = delete;
-  std::ostream& stream() { return out_; }
-  void commit();
-
- private:
-  std::filesystem::path path_;
-  std::filesystem::path tmp_;
-  std::ofstream out_;
-  bool committed_ = false;
-};
 
 /// summary.json: status, message, steps, end_time, dt, particles, nodes,
 /// solve_seconds, particle_steps_per_second, plus warnings, name,

@@ -1,7 +1,7 @@
-// plausibility.cpp — see plausibility.hpp. The ranges and rules are
+// problem/plausibility.cpp — see plausibility.hpp. The ranges and rules are
 // documented in docs/job-spec.md ("Plausibility warnings"); a change here
 // changes that table.
-#include "plausibility.hpp"
+#include "problem/plausibility.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-// plausibility.hpp — warnings for values a runnable Problem holds that are
+// problem/plausibility.hpp — warnings for values a runnable Problem holds that are
 // far outside soil and rock ranges, and for loads and slopes a simple
 // estimate says will fail (internal; docs/job-spec.md "Plausibility
 // warnings" has the table of ranges and the rules). Called by

@@ -1,4 +1,4 @@
-// worker_pool.hpp — the threads that run jobs, one job per worker at a time.
+// workers/pool.hpp — the threads that run jobs, one job per worker at a time.
 //
 // Workers take the oldest accepted job from the store (FIFO), re-parse its
 // stored spec (the database stays the only source of truth), run it with
@@ -17,6 +17,10 @@
 // store says whether its files stay: keep_results); a shutdown puts it back
 // in the queue so the next start resumes it. Each job's log (run_log.hpp) is
 // written here.
+//
+// The pool (workers/pool.cpp) claims jobs, renews leases and runs recovery;
+// one attempt at a job, from its folder's preparation to the end written to
+// the store, is workers/attempt.cpp; the job's folder is job_files.hpp.
 //
 // Every job is claimed for this process's instance (`WorkerSettings::claimant`);
 // a heartbeat thread renews the leases of the running jobs every
@@ -41,6 +45,7 @@
 
 #include "hmpm/api/job.hpp"
 #include "hmpm/server/store.hpp"
+#include "job_files.hpp"
 #include "metrics.hpp"
 
 namespace hmpm::server {
@@ -59,6 +64,13 @@ struct WorkerSettings {
   double checkpoint_interval_s = 60.0;
   int max_attempts = 3;          ///< recover(): starts of a job before it fails
   double charge_after_s = 30.0;  ///< recover(): see ServiceConfig::charge_after_s
+};
+
+/// What a worker and the threads that stop it share about a running job.
+struct RunningJob {
+  std::atomic<bool> cancel{false};
+  std::atomic<bool> dismissed{false};
+  std::atomic<bool> lost{false};  ///< another claim replaced ours
 };
 
 /// One log line per job that recovery requeued or failed.
@@ -84,24 +96,14 @@ class WorkerPool {
   /// stop_claiming(), then joins the threads. Idempotent.
   void shutdown();
 
-  /// The folder of job `id`: its log and one folder per attempt.
-  std::filesystem::path job_dir(const std::string& id) const;
-  /// Where the attempt of `claim` writes its result and checkpoint files.
-  std::filesystem::path attempt_dir(const Claim& claim) const;
-  /// Where the result files of the ended job `job` live: the folder of the
-  /// claim that recorded them (its token is the row's), or the job folder
-  /// itself for a job that ended before attempt folders existed.
-  std::filesystem::path results_dir(const JobRecord& job) const;
+  /// The job folders the workers write (settings' data_dir).
+  const JobFiles& files() const { return files_; }
 
  private:
-  struct Running {
-    std::atomic<bool> cancel{false};
-    std::atomic<bool> dismissed{false};
-    std::atomic<bool> lost{false};  ///< another claim replaced ours
-  };
   void work();
   void heartbeat();
-  void run_one(const JobRecord& job, Running& running);
+  // One attempt at `job` (workers/attempt.cpp).
+  void run_one(const JobRecord& job, RunningJob& running);
   // A write of `claim` was refused: another claim replaced ours (counted,
   // logged); then discard_if_ended.
   void claim_lost(const Claim& claim, double seconds);
@@ -124,6 +126,7 @@ class WorkerPool {
   JobStore& store_;
   Metrics& metrics_;
   WorkerSettings settings_;
+  JobFiles files_;
   std::mutex mutex_;
   std::condition_variable wake_;            ///< workers: a job was queued, or stop
   std::condition_variable heartbeat_wake_;  ///< the heartbeat thread: stop
@@ -131,7 +134,7 @@ class WorkerPool {
   std::condition_variable retry_wake_;      ///< a worker retrying a store write: stop
   bool stopping_ = false;
   std::uint64_t generation_ = 0;  ///< bumped by notify()
-  std::map<std::string, std::shared_ptr<Running>> running_;
+  std::map<std::string, std::shared_ptr<RunningJob>> running_;
   std::vector<std::thread> threads_;
   std::thread heartbeat_;
 };

@@ -1,0 +1,52 @@
+// results/summary.cpp — summary.json (results/writers.hpp), built as
+// nlohmann's ordered_json: keys in the order a reader meets them.
+#include <nlohmann/json.hpp>
+
+#include "results/writers.hpp"
+
+namespace hmpm::api {
+
+void write_summary(const std::filesystem::path& path, const std::string& job_name,
+                   const RunResult& run, const CostEstimate& cost,
+                   const std::vector<std::string>& files) {
+  nlohmann::ordered_json o;
+  o["status"] = status_name(run.status);
+  o["message"] = run.message;
+  o["steps"] = run.steps;
+  o["end_time"] = run.end_time;  // nlohmann writes a non-finite number as null
+  o["dt"] = run.dt;
+  o["scheme"] = run.scheme;
+  if (run.reports_iterations) {
+    const RunResult::Iterations& it = run.iterations;
+    o["iterations"] = {{"nonlinear", it.nonlinear},
+                       {"linear", it.linear},
+                       {"solves", it.solves},
+                       {"cutbacks", it.cutbacks},
+                       {"max_nonlinear", it.max_nonlinear}};
+  }
+  o["particles"] = run.particles;
+  o["nodes"] = run.nodes;
+  o["solve_seconds"] = run.solve_seconds;
+  o["particle_steps_per_second"] = run.particle_steps_per_second;
+  o["warnings"] = run.warnings;
+  o["name"] = job_name;
+  o["hmpm_version"] = version();
+  o["state_bytes"] = run.state_bytes;
+  o["cost"] = {{"particles", cost.particles},
+               {"nodes", cost.nodes},
+               {"cells", cost.cells},
+               {"steps", cost.steps},
+               {"dt", cost.dt},
+               {"particle_steps", cost.particle_steps},
+               {"memory_bytes", cost.memory_bytes},
+               {"output_bytes", cost.output_bytes},
+               {"series_rows", cost.series_rows},
+               {"snapshots", cost.snapshots}};
+  o["files"] = files;
+  AtomicFile file(path);
+  // Replaced, not thrown on: a message may quote bytes that are not UTF-8.
+  file.stream() << o.dump(2, ' ', false, nlohmann::ordered_json::error_handler_t::replace) << "\n";
+  file.commit();
+}
+
+}  // namespace hmpm::api
