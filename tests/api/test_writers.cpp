@@ -297,6 +297,7 @@ TEST(Writers, SummaryNamesTheSchemeAndTheImplicitIterations) {
   RunResult run;
   run.status = RunStatus::successful;
   run.scheme = "quasi_static";
+  run.reports_iterations = true;  // what the quasi-static and semi-implicit schemes set
   run.iterations.nonlinear = 123;
   run.iterations.linear = 4567;
   run.iterations.solves = 130;
