@@ -2,6 +2,7 @@
 #include "job_files.hpp"
 
 #include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -127,6 +128,45 @@ void write_durably(const std::filesystem::path& path, const std::string& bytes) 
     ::fsync(dir);
     ::close(dir);
   }
+}
+
+std::string read_checkpoint_file(const std::filesystem::path& path, std::int64_t expected_size) {
+  const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_NOCTTY | O_CLOEXEC);
+  if (fd < 0) {
+    throw std::runtime_error(errno == ENOENT
+                                 ? std::string("is missing")
+                                 : std::string("cannot be opened: ") + std::strerror(errno));
+  }
+  struct Closer {
+    int fd;
+    ~Closer() { ::close(fd); }
+  } closer{fd};
+  struct stat st {};
+  if (::fstat(fd, &st) != 0)
+    throw std::runtime_error(std::string("cannot be examined: ") + std::strerror(errno));
+  if (!S_ISREG(st.st_mode)) {
+    const char* kind = S_ISDIR(st.st_mode)    ? "a directory"
+                       : S_ISFIFO(st.st_mode) ? "a FIFO"
+                       : S_ISCHR(st.st_mode)  ? "a character device"
+                       : S_ISBLK(st.st_mode)  ? "a block device"
+                       : S_ISSOCK(st.st_mode) ? "a socket"
+                                              : "not a regular file";
+    throw std::runtime_error(std::string("is ") + kind + ", not a regular file");
+  }
+  if (st.st_size != expected_size) {
+    throw std::runtime_error("has " + std::to_string(st.st_size) + " bytes, " +
+                             std::to_string(expected_size) + " recorded");
+  }
+  std::string bytes(static_cast<std::size_t>(expected_size), '\0');
+  std::size_t done = 0;
+  while (done < bytes.size()) {
+    const ssize_t n = ::read(fd, bytes.data() + done, bytes.size() - done);
+    if (n < 0 && (errno == EINTR || errno == EAGAIN)) continue;
+    if (n < 0) throw std::runtime_error(std::string("cannot be read: ") + std::strerror(errno));
+    if (n == 0) throw std::runtime_error("ended after " + std::to_string(done) + " bytes");
+    done += static_cast<std::size_t>(n);
+  }
+  return bytes;
 }
 
 std::optional<std::string> record_files(const std::filesystem::path& dir,

@@ -76,6 +76,14 @@ void remove_checkpoints_but(const std::filesystem::path& dir, const std::string&
 /// `path`, fsync of the folder. Throws std::runtime_error.
 void write_durably(const std::filesystem::path& path, const std::string& bytes);
 
+/// The bytes of the checkpoint file `path`, which must be a regular file
+/// of `expected_size` bytes. Opened without blocking (O_NONBLOCK: a FIFO
+/// put in its place opens at once) and checked with fstat before a byte is
+/// read, so a directory, a FIFO, a device (a symlink to /dev/zero) or a
+/// file of another size is refused at once, never read until it ends.
+/// Throws std::runtime_error saying which.
+std::string read_checkpoint_file(const std::filesystem::path& path, std::int64_t expected_size);
+
 /// Size, SHA-256 and media type of each of `names` in `dir`, appended to
 /// `files`; the name of the first one that cannot be read back, if any.
 std::optional<std::string> record_files(const std::filesystem::path& dir,

@@ -77,7 +77,8 @@ std::string usage() {
          "                   [--max-event-streams N] [--http-threads N] [--retain-days N]\n"
          "                   [--checkpoint-interval S] [--lease-seconds S]\n"
          "                   [--max-connections N] [--request-head-timeout S]\n"
-         "                   [--request-body-timeout S] [--event-stream-max-seconds S]\n"
+         "                   [--request-body-timeout S] [--send-stall-timeout S]\n"
+         "                   [--event-stream-max-seconds S]\n"
          "                   [--allow-no-token] [--allowed-host NAME[:PORT]]...\n"
          "                   [--allowed-origin ORIGIN]...\n"
          "  --host H              address to listen on (default 127.0.0.1); any address but\n"
@@ -118,6 +119,9 @@ std::string usage() {
          "  --max-connections N   connections served at once, 503 beyond (default 256)\n"
          "  --request-head-timeout S  a request's line and headers must arrive in S s (10)\n"
          "  --request-body-timeout S  a request's body must arrive in S s (60)\n"
+         "  --send-stall-timeout S  an answer (a download, an event stream) whose client\n"
+         "                        has taken no byte for S s is ended: slower readers are\n"
+         "                        served at any rate (default 120)\n"
          "  --event-stream-max-seconds S  an event stream ends after S s; the client\n"
          "                        reconnects (default 300)\n"
          "  --retain-days N       purge jobs that ended (successful, failed, dismissed) more than\n"
@@ -234,6 +238,7 @@ ParsedOptions parse_options(const std::vector<std::string>& args, const char* en
        integer(2, 100'000, [&](long n) { config.max_connections = static_cast<int>(n); })},
       {"--request-head-timeout", positive_seconds(config.head_timeout_s)},
       {"--request-body-timeout", positive_seconds(config.body_timeout_s)},
+      {"--send-stall-timeout", positive_seconds(config.send_stall_s)},
       {"--event-stream-max-seconds", positive_seconds(config.event_stream_max_s)},
       {"--allowed-host",
        [&](const std::string& v) {

@@ -94,6 +94,7 @@ http::ConnectionLimits connection_limits(const ServiceConfig& c) {
   http::ConnectionLimits limits;
   limits.head_timeout_s = c.head_timeout_s;
   limits.body_timeout_s = c.body_timeout_s;
+  limits.send_stall_s = c.send_stall_s;
   limits.core_threads = static_cast<std::size_t>(c.http_threads);
   limits.max_connections = static_cast<std::size_t>(std::max(c.max_connections, c.http_threads));
   return limits;
@@ -125,7 +126,7 @@ struct Service::Impl {
                              "data folder " + c.data_dir.string());
   }
   static std::unique_ptr<JobStore> open_store(const ServiceConfig& c) {
-    if (on_postgres(c)) return open_postgres_store(c.db_path.string());
+    if (on_postgres(c)) return open_postgres_store(c.db_path.string(), {}, c.data_dir);
     return open_sqlite_store(c.db_path);
   }
 

@@ -139,6 +139,19 @@ TEST_F(PostgresStoreTest, AnUnreachableDatabaseIsAStoreFailureWithoutThePassword
 
 // Several servers (stores with their own connections and instance ids)
 // claiming from one queue at once: SKIP LOCKED hands every job to exactly one.
+// Issue 45 item 2: every connection bounds its statements, lock waits and
+// idle transactions (a paused server's locks are released), unless the
+// operator set a limit (here through the URI's options, which win).
+TEST_F(PostgresStoreTest, ConnectionsSetStatementLockAndIdleTransactionLimits) {
+  EXPECT_EQ(query("SHOW statement_timeout"), "30s;");
+  EXPECT_EQ(query("SHOW lock_timeout"), "2s;");
+  EXPECT_EQ(query("SHOW idle_in_transaction_session_timeout"), "10s;");
+  postgres::ConnectionPool pool(uri_ + "%20-clock_timeout%3D5s");
+  auto db = pool.lease();
+  EXPECT_EQ(postgres::exec(db.get(), "SHOW lock_timeout").text(0, 0), "5s");
+  EXPECT_EQ(postgres::exec(db.get(), "SHOW statement_timeout").text(0, 0), "30s");
+}
+
 TEST_F(PostgresStoreTest, ManyServersClaimingAtOnceNeverShareAJob) {
   constexpr int servers = 3;
   constexpr int threads_per_server = 3;

@@ -89,12 +89,8 @@ std::string_view trim_blanks(std::string_view v) {
 class DeadlineStream final : public httplib::Stream {
  public:
   DeadlineStream(socket_t sock, const std::atomic<socket_t>& listener,
-                 const ConnectionLimits& limits, int read_timeout_ms, int write_timeout_ms)
-      : sock_(sock),
-        listener_(listener),
-        limits_(limits),
-        read_timeout_ms_(read_timeout_ms),
-        write_timeout_ms_(write_timeout_ms) {}
+                 const ConnectionLimits& limits, int read_timeout_ms)
+      : sock_(sock), listener_(listener), limits_(limits), read_timeout_ms_(read_timeout_ms) {}
 
   // A new request: its head is due within the head timeout from now.
   void begin_request() {
@@ -116,7 +112,7 @@ class DeadlineStream final : public httplib::Stream {
 
   bool is_writable() const override {
     // No peek for EOF: a client that half-closed after sending still reads.
-    return wait_for(sock_, POLLOUT, write_timeout_ms_);
+    return writable_or_draining();
   }
 
   ssize_t read(char* ptr, std::size_t size) override {
@@ -182,19 +178,20 @@ class DeadlineStream final : public httplib::Stream {
 
  private:
   // Waits until the socket takes more bytes. A client that keeps reading,
-  // however slowly, is waited for: only a send queue that has not shrunk
-  // for the write timeout (a stalled reader) gives up. (POLLOUT alone comes
-  // only once a third of the send buffer is free, which a reader at a few
-  // hundred kB/s takes longer than the timeout to make.)
+  // however slowly or in bursts, is waited for: only a send queue that has
+  // not shrunk for the stall timeout (a stalled reader) gives up, which ends
+  // the connection and frees its thread. (POLLOUT alone comes only once a
+  // third of the send buffer is free, which a slow reader takes long to make;
+  // and a reader such as curl --limit-rate takes a burst, then pauses.)
   bool writable_or_draining() const {
     constexpr int slice_ms = 250;
     int queued = -1;
-    auto stalled_at = after(write_timeout_ms_ / 1000.0);
+    auto stalled_at = after(limits_.send_stall_s);
     for (;;) {
-      if (wait_for(sock_, POLLOUT, std::min(slice_ms, write_timeout_ms_))) return true;
+      if (wait_for(sock_, POLLOUT, slice_ms)) return true;
       int now_queued = 0;
       if (::ioctl(sock_, SIOCOUTQ, &now_queued) != 0) return false;
-      if (queued < 0 || now_queued < queued) stalled_at = after(write_timeout_ms_ / 1000.0);
+      if (queued < 0 || now_queued < queued) stalled_at = after(limits_.send_stall_s);
       queued = now_queued;
       if (SteadyClock::now() >= stalled_at) return false;
     }
@@ -235,7 +232,6 @@ class DeadlineStream final : public httplib::Stream {
   const std::atomic<socket_t>& listener_;  ///< INVALID_SOCKET once the server stops
   const ConnectionLimits& limits_;
   int read_timeout_ms_;
-  int write_timeout_ms_;
   std::array<char, 16384> buffer_{};
   std::size_t begin_ = 0;
   std::size_t end_ = 0;
@@ -430,8 +426,7 @@ bool HardenedServer::process_and_close_socket(socket_t sock) {
     const std::string busy = busy_response();
     ::send(sock, busy.data(), busy.size(), MSG_NOSIGNAL);
   } else {
-    DeadlineStream stream(sock, svr_sock_, limits_, to_ms(read_timeout_sec_, read_timeout_usec_),
-                          to_ms(write_timeout_sec_, write_timeout_usec_));
+    DeadlineStream stream(sock, svr_sock_, limits_, to_ms(read_timeout_sec_, read_timeout_usec_));
     const int keep_alive_ms = static_cast<int>(keep_alive_timeout_sec_ * 1000);
     for (std::size_t count = keep_alive_max_count_; count > 0; --count) {
       // Idle between requests: wait in slices, so a stopping server is seen.

@@ -32,6 +32,11 @@ namespace hmpm::server::http {
 struct ConnectionLimits {
   double head_timeout_s = 10.0;  ///< request line + headers, in total
   double body_timeout_s = 60.0;  ///< the whole body, in total
+  /// An answer waits for its client as long as the socket's send queue
+  /// shrinks; one that has not shrunk for this long (a stalled reader) ends
+  /// the connection. Long enough for readers that pause between bursts
+  /// (curl --limit-rate reads about 50 s worth at once, then waits).
+  double send_stall_s = 120.0;
   std::size_t max_head_bytes = 65536;
   std::size_t max_header_count = 100;
   std::size_t core_threads = 24;      ///< threads kept ready

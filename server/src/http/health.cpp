@@ -4,6 +4,12 @@
 #include "problem.hpp"
 
 namespace hmpm::server::http {
+namespace {
+
+// How the PostgreSQL store's write probe begins its reasons (postgres_store.cpp).
+constexpr const char* pg_unwritable_prefix = "the database cannot be written (postgresql): ";
+
+}  // namespace
 
 // Ready means the database can be read and written (the store's probe);
 // the answer names which failed but not the server's paths (no token here).
@@ -20,12 +26,21 @@ void get_health(Context& c, const httplib::Request&, httplib::Response& res) {
   } catch (const StoreFailure& e) {
     const std::string what = e.what();
     const bool unwritable = what.find("cannot be written") != std::string::npos;
+    // PostgreSQL's write probe says why in words of its own (no paths):
+    // "the database cannot be written: a lock on the jobs table was not
+    // granted within 1 s".
+    const auto reason = what.find(pg_unwritable_prefix);
+    std::string detail = "the database cannot be read";
+    if (e.no_space()) {
+      detail = "no space left: the database cannot be written";
+    } else if (reason != std::string::npos) {
+      detail = "the database cannot be written: " +
+               what.substr(reason + std::string_view(pg_unwritable_prefix).size());
+    } else if (unwritable) {
+      detail = "the database cannot be written";
+    }
     res.set_header("Retry-After", std::to_string(store_retry_after_s));
-    send_json(res, 503,
-              Json{{"status", "unavailable"},
-                   {"detail", e.no_space() ? "no space left: the database cannot be written"
-                                           : (unwritable ? "the database cannot be written"
-                                                         : "the database cannot be read")}});
+    send_json(res, 503, Json{{"status", "unavailable"}, {"detail", detail}});
   } catch (const std::exception&) {
     res.set_header("Retry-After", std::to_string(store_retry_after_s));
     send_json(res, 503, Json{{"status", "unavailable"}, {"detail", "the database cannot be read"}});

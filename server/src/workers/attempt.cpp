@@ -5,7 +5,6 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <fstream>
 #include <iterator>
 #include <optional>
 #include <stdexcept>
@@ -55,25 +54,28 @@ std::string short_number(double x) {
 }
 
 // The bytes of the recorded checkpoint `rec` in `dir` when the file is
-// there, has the recorded SHA-256 and belongs to `job` (spec text `key`);
-// otherwise nullopt, with why in `why`.
+// there, a regular file of the recorded size and SHA-256 that belongs to
+// `job` (spec text `key`); otherwise nullopt, with why in `why`. Whatever
+// stands in the file's place (a directory, a FIFO, a device) is refused
+// without blocking or reading it (read_checkpoint_file).
 std::optional<std::string> read_checkpoint(const std::filesystem::path& dir,
                                            const CheckpointRecord& rec,
                                            const hmpm::api::ParsedJob& job, const std::string& key,
                                            std::string& why) {
-  std::ifstream in(dir / rec.file, std::ios::binary);
-  if (!in) {
-    why = "its file " + rec.file + " is missing";
+  std::string bytes;
+  try {
+    bytes = read_checkpoint_file(dir / rec.file, rec.size);
+  } catch (const std::exception& e) {
+    why = "its file " + rec.file + " " + e.what();
     return std::nullopt;
   }
-  std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   if (sha256_hex(bytes) != rec.sha256) {
     why = "its file " + rec.file + " does not have the recorded SHA-256";
     return std::nullopt;
   }
   try {
     (void)hmpm::inspect_checkpoint(job.problem, key, bytes);
-  } catch (const std::invalid_argument& e) {
+  } catch (const std::exception& e) {
     why = std::string("the solver refuses it: ") + e.what();
     return std::nullopt;
   }

@@ -54,6 +54,7 @@ struct ServiceConfig {
   int max_connections = 256;          ///< connections served at once (a thread each); 503 beyond
   double head_timeout_s = 10.0;       ///< a request's line and headers must arrive within this
   double body_timeout_s = 60.0;       ///< a request's body must arrive within this
+  double send_stall_s = 120.0;        ///< an answer whose client took no byte for this long ends
   double event_stream_max_s = 300.0;  ///< an event stream ends after this; the client reconnects
   bool allow_no_token = false;  ///< a non-loopback --host without a token starts (with a warning)
   /// Host header values accepted besides the listening address (NAME, any

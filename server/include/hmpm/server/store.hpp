@@ -324,6 +324,11 @@ bool is_postgres_uri(std::string_view db);
 /// Timestamps and leases come from `clock` (empty: the system clock), so
 /// the servers' clocks must agree to well under a lease (NTP). Throws
 /// StoreFailure when it cannot connect or the schema is newer than this build.
-std::unique_ptr<JobStore> open_postgres_store(const std::string& uri, WallClock clock = {});
+/// With `data_dir` (a server's --data-dir), also when that folder is not the
+/// one the database records for its servers (the random id of the folder's
+/// `.hmpm-data-dir` file; the first server records it): servers sharing a
+/// database must share the data folder.
+std::unique_ptr<JobStore> open_postgres_store(const std::string& uri, WallClock clock = {},
+                                              const std::filesystem::path& data_dir = {});
 
 }  // namespace hmpm::server

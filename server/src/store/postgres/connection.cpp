@@ -1,6 +1,8 @@
 // connection.cpp — see connection.hpp.
 #include "connection.hpp"
 
+#include <unistd.h>
+
 #include <charconv>
 #include <cstdlib>
 #include <utility>
@@ -116,7 +118,16 @@ ConnectionPool::~ConnectionPool() {
 }
 
 PGconn* ConnectionPool::open_connection() {
-  PGconn* db = PQconnectdb(uri_.c_str());
+  // The client side of a cut network: give up connecting after 5 s, and
+  // notice a peer that stopped answering (keepalives; unacknowledged data
+  // for 30 s). Given before the URI, so the URI's own values win.
+  // Sessions are named "hmpm-server <pid>" in pg_stat_activity.
+  const std::string name = "hmpm-server " + std::to_string(::getpid());
+  const char* keywords[] = {"connect_timeout",           "keepalives",       "keepalives_idle",
+                            "keepalives_interval",       "keepalives_count", "tcp_user_timeout",
+                            "fallback_application_name", "dbname",           nullptr};
+  const char* values[] = {"5", "1", "10", "5", "3", "30000", name.c_str(), uri_.c_str(), nullptr};
+  PGconn* db = PQconnectdbParams(keywords, values, 1);
   if (PQstatus(db) != CONNECTION_OK) {
     std::string message = db ? PQerrorMessage(db) : "out of memory";
     while (!message.empty() && message.back() == '\n') message.pop_back();
@@ -127,6 +138,20 @@ PGconn* ConnectionPool::open_connection() {
     // Quiet NOTICEs (CREATE ... IF NOT EXISTS) and UTC for any server-side time.
     exec(db, "SET client_min_messages = warning");
     exec(db, "SET TIME ZONE 'UTC'");
+    // The server side: no statement, lock wait or open transaction of ours
+    // lasts without bound (a paused or cut-off server's transaction is
+    // ended, its locks released), unless the operator set the limit (the
+    // URI's options, ALTER ROLE/DATABASE ... SET, postgresql.conf).
+    std::string names;
+    for (const auto& [name, value] : session_limits)
+      names += std::string(names.empty() ? "'" : ",'") + name + "'";
+    const Result unset = exec(
+        db, "SELECT name FROM pg_settings WHERE source = 'default' AND name IN (" + names + ")");
+    for (int i = 0; i < unset.rows(); ++i) {
+      for (const auto& [name, value] : session_limits) {
+        if (unset.text(i, 0) == name) exec(db, std::string("SET ") + name + " = '" + value + "'");
+      }
+    }
   } catch (...) {
     PQfinish(db);
     throw;

@@ -17,6 +17,7 @@
 #include <mutex>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 namespace hmpm::server::postgres {
@@ -117,6 +118,16 @@ class ConnectionPool {
   std::string uri_;
   std::mutex mutex_;
   std::vector<PGconn*> idle_;
+};
+
+/// The limits every connection sets (name, value) unless the operator
+/// configured them: a statement runs at most 30 s, waits for a lock at
+/// most 2 s, and a transaction left idle (its server paused or cut off) is
+/// ended after 10 s, which releases its locks.
+inline constexpr std::pair<const char*, const char*> session_limits[] = {
+    {"statement_timeout", "30s"},
+    {"lock_timeout", "2s"},
+    {"idle_in_transaction_session_timeout", "10s"},
 };
 
 /// `uri` without its password, for messages and logs.

@@ -34,6 +34,11 @@ void migrate(PGconn* db) {
       throw StoreFailure(std::string("migration ") + migrations[i].name + " is out of sequence");
   }
   Transaction tx(db);
+  // A migration may rewrite a large table, and the servers starting beside
+  // this one wait for it: no statement or lock limit here (a paused
+  // migrating server is still ended by idle_in_transaction_session_timeout).
+  exec(db, "SET LOCAL statement_timeout = 0");
+  exec(db, "SET LOCAL lock_timeout = 0");
   exec(db, migration_lock);
   const int version = recorded_version(db);
   if (version > latest_version()) {

@@ -7,11 +7,19 @@
 // of job_attempts, ended by finish, requeue, dismissal or recovery.
 #include "postgres_store.hpp"
 
+#include <unistd.h>
+
 #include <algorithm>
+#include <cerrno>
 #include <chrono>
+#include <cstring>
+#include <fstream>
+#include <string_view>
 #include <utility>
 
 #include "clock.hpp"
+#include "digest.hpp"
+#include "job_files.hpp"
 #include "migrate.hpp"
 #include "store/recovery.hpp"
 
@@ -26,10 +34,6 @@ std::string sql_name(JobStatus status) {
 const std::string ended_statuses = "(" + sql_name(JobStatus::successful) + "," +
                                    sql_name(JobStatus::failed) + "," +
                                    sql_name(JobStatus::dismissed) + ")";
-
-// pg_advisory_xact_lock key that serialises submissions, so the queue cap
-// and the idempotency-key check hold across servers ("hmpn" in ASCII).
-constexpr const char* submit_lock = "SELECT pg_advisory_xact_lock(1752001902)";
 
 // The last column is an accepted job's place in the queue (1: next); in a
 // RETURNING clause the subquery sees the rows as they were before.
@@ -140,6 +144,63 @@ void replace_results(PGconn* db, const std::string& id, const std::vector<Result
   }
 }
 
+// The file in a data folder that names it (a random id, made once).
+constexpr const char* data_folder_marker = ".hmpm-data-dir";
+constexpr const char* data_folder_prefix = "hmpm data folder ";
+
+// The id `marker` holds, "" if there is no such file.
+std::string read_data_folder_id(const std::filesystem::path& marker) {
+  std::ifstream in(marker);
+  if (!in) return "";
+  std::string line;
+  std::getline(in, line);
+  if (line.rfind(data_folder_prefix, 0) != 0)
+    throw StoreFailure(marker.string() + " is not an hmpm data folder's identity file");
+  return line.substr(std::string_view(data_folder_prefix).size());
+}
+
+// Makes `marker` with a new id, or reads the one another server made first.
+std::string create_data_folder_id(const std::filesystem::path& marker) {
+  const std::string id = new_uuid_v4();
+  const std::filesystem::path tmp = marker.string() + "." + id + ".tmp";
+  try {
+    write_durably(tmp, data_folder_prefix + id + "\n");
+  } catch (const std::exception& e) {
+    throw StoreFailure(std::string("cannot write the data folder's identity: ") + e.what());
+  }
+  // link(): the file appears whole, and only once if servers race.
+  const int linked = ::link(tmp.c_str(), marker.c_str());
+  const int error = errno;
+  ::unlink(tmp.c_str());
+  if (linked != 0 && error != EEXIST) {
+    throw StoreFailure("cannot create " + marker.string() + ": " + std::strerror(error));
+  }
+  return read_data_folder_id(marker);
+}
+
+// One write within short limits, sent as one message (BEGIN ... COMMIT):
+// the transaction never waits on this server, so a pause here cannot hold
+// its row lock. ROW EXCLUSIVE on jobs is what a submission takes: a lock
+// that blocks submissions (LOCK TABLE, a long ALTER) blocks the probe too.
+ProbeOutcome write_probe(PGconn* db) {
+  const Result r(PQexec(db,
+                        "BEGIN; SET LOCAL lock_timeout = '1s'; SET LOCAL statement_timeout = '2s'; "
+                        "LOCK TABLE jobs IN ROW EXCLUSIVE MODE; INSERT INTO store_probe (id, "
+                        "written) VALUES (1, now()::text) ON CONFLICT (id) DO UPDATE SET "
+                        "written = excluded.written; COMMIT"));
+  if (r.status() == PGRES_COMMAND_OK || r.status() == PGRES_TUPLES_OK) return {};
+  const std::string state = r.sqlstate();
+  PQclear(PQexec(db, "ROLLBACK"));
+  const std::string prefix = "the database cannot be written (postgresql): ";
+  if (state == "55P03") return {prefix + "a lock on the jobs table was not granted within 1 s"};
+  if (state == "57014") return {prefix + "a one-row write did not finish within 2 s"};
+  if (state == "25006") return {prefix + "it is read-only"};
+  if (state == "53100") return {prefix + "no space left", true};
+  if (PQstatus(db) != CONNECTION_OK) return {prefix + "the connection was lost"};
+  return {prefix + "error " +
+          (state.empty() ? std::string("without SQLSTATE") : "SQLSTATE " + state)};
+}
+
 }  // namespace
 
 std::chrono::system_clock::time_point PostgresStore::now() const {
@@ -158,55 +219,94 @@ std::int64_t PostgresStore::lease_until(const Claimant& who) const {
   return now_ms() + static_cast<std::int64_t>(who.lease_s * 1000.0);
 }
 
-PostgresStore::PostgresStore(const std::string& uri, WallClock clock)
+PostgresStore::PostgresStore(const std::string& uri, WallClock clock,
+                             const std::filesystem::path& data_dir)
     : clock_(std::move(clock)), pool_(uri) {
   auto connection = pool_.lease();
   migrate(connection.get());
+  if (!data_dir.empty()) check_data_dir(connection.get(), data_dir);
+}
+
+void PostgresStore::check_data_dir(PGconn* db, const std::filesystem::path& data_dir) {
+  const std::filesystem::path marker = data_dir / data_folder_marker;
+  std::string mine = read_data_folder_id(marker);
+  Result row = exec(db, "SELECT identity, path FROM data_folder WHERE id = 1");
+  if (row.rows() == 0) {
+    // The first server on this database: its folder becomes the shared one.
+    if (mine.empty()) mine = create_data_folder_id(marker);
+    exec(db,
+         "INSERT INTO data_folder (id, identity, path, recorded) VALUES (1, $1, $2, $3) "
+         "ON CONFLICT (id) DO NOTHING",
+         Params().add(mine).add(data_dir.string()).add(now_text()));
+    row = exec(db, "SELECT identity, path FROM data_folder WHERE id = 1");
+  }
+  const std::string recorded = row.text(0, 0);
+  if (mine == recorded) return;
+  throw StoreFailure(
+      "data folder " + data_dir.string() +
+      " is not the one the servers on this database share: the database records data folder " +
+      recorded + " (first used at " + row.text(0, 1) + "), and " +
+      (mine.empty() ? marker.string() + " is missing"
+                    : marker.string() + " names data folder " + mine) +
+      ". Give every server on this database the same --data-dir (one folder, on a filesystem "
+      "they share); to move the folder, move all of it, its " +
+      data_folder_marker + " included (docs/api.md, \"Many servers on one PostgreSQL\")");
 }
 
 void PostgresStore::probe() {
-  auto db = pool_.lease();
-  recorded_version(db.get());
+  auto connection = pool_.lease();
+  PGconn* db = connection.get();
+  try {
+    recorded_version(db);
+  } catch (const StoreFailure& e) {
+    throw StoreFailure(std::string("the database cannot be read: ") + e.what(), e.no_space());
+  }
+  write_probe_.check([&] { return write_probe(db); });
 }
 
+// One statement, no transaction of ours around it and no lock a server
+// could keep (a paused or cut-off server cannot hold up the others'
+// submissions): the row goes in unless the queue is full, and an
+// idempotency key used before is refused by its unique index (ON CONFLICT
+// DO NOTHING); then the earlier job with that key is read. A same-key
+// submission still being inserted elsewhere is waited for, as long as
+// lock_timeout. The queue cap is read in the statement's snapshot: servers
+// submitting at the same instant may each take the last place (the cap
+// then overshoots by at most the submissions in flight).
 SubmitResult PostgresStore::submit(const NewJob& job, std::int64_t max_queue) {
   auto connection = pool_.lease();
   PGconn* db = connection.get();
-  Transaction tx(db);
-  exec(db, submit_lock);
-  if (!job.idempotency_key.empty()) {
-    const Result r = exec(db, "SELECT id, body_sha256 FROM jobs WHERE idempotency_key = $1",
-                          Params().add(job.idempotency_key));
-    if (r.rows() > 0) {
-      const bool same_body = r.text(0, 1) == job.body_sha256;
-      auto earlier = select_job(db, r.text(0, 0));
-      tx.commit();
-      return {same_body ? SubmitOutcome::replayed : SubmitOutcome::key_conflict,
-              std::move(*earlier)};
-    }
-  }
-  if (exec(db, "SELECT count(*) FROM jobs WHERE status = " + sql_name(JobStatus::accepted))
-          .integer(0, 0) >= max_queue) {
-    return {SubmitOutcome::queue_full, {}};
-  }
   Params p;
   p.add(job.id).add(job.name).add(job.spec).add(now_text());
   p.add_or_null(job.idempotency_key).add_or_null(job.body_sha256);
   p.add(job.cost.particles).add(job.cost.nodes).add(job.cost.cells).add(job.cost.steps);
   p.add(job.cost.particle_steps).add(job.cost.memory_bytes).add(job.cost.output_bytes);
-  p.add(job.cost.dt);
-  const Result r =
-      exec(db,
-           "INSERT INTO jobs (id, name, spec, status, message, created, updated, idempotency_key, "
-           "body_sha256, cost_particles, cost_nodes, cost_cells, cost_steps, cost_particle_steps, "
-           "cost_memory_bytes, cost_output_bytes, cost_dt) VALUES ($1, $2, $3, " +
-               sql_name(JobStatus::accepted) +
-               ", 'queued', $4, $4, $5, $6, $7, $8, $9, $10, $11, $12, $13, $14) RETURNING " +
-               job_columns,
-           p);
-  JobRecord created = read_job(r, 0);
-  tx.commit();
-  return {SubmitOutcome::created, std::move(created)};
+  p.add(job.cost.dt).add(max_queue);
+  const Result r = exec(
+      db,
+      "INSERT INTO jobs (id, name, spec, status, message, created, updated, idempotency_key, "
+      "body_sha256, cost_particles, cost_nodes, cost_cells, cost_steps, cost_particle_steps, "
+      "cost_memory_bytes, cost_output_bytes, cost_dt) SELECT $1, $2, $3, " +
+          sql_name(JobStatus::accepted) +
+          ", 'queued', $4, $4, $5, $6, $7::bigint, $8::bigint, $9::bigint, $10::bigint, "
+          "$11::bigint, $12::bigint, $13::bigint, $14::double precision WHERE (SELECT count(*) "
+          "FROM jobs WHERE status = " +
+          sql_name(JobStatus::accepted) +
+          ") < $15::bigint ON CONFLICT (idempotency_key) DO NOTHING RETURNING " + job_columns,
+      p);
+  if (r.rows() == 1) return {SubmitOutcome::created, read_job(r, 0)};
+  if (!job.idempotency_key.empty()) {
+    const Result earlier = exec(db, "SELECT id, body_sha256 FROM jobs WHERE idempotency_key = $1",
+                                Params().add(job.idempotency_key));
+    if (earlier.rows() > 0) {
+      if (auto found = select_job(db, earlier.text(0, 0))) {
+        return {earlier.text(0, 1) == job.body_sha256 ? SubmitOutcome::replayed
+                                                      : SubmitOutcome::key_conflict,
+                std::move(*found)};
+      }
+    }
+  }
+  return {SubmitOutcome::queue_full, {}};
 }
 
 std::optional<JobRecord> PostgresStore::find(const std::string& id) {
@@ -517,8 +617,9 @@ bool is_postgres_uri(std::string_view db) {
   return db.rfind("postgresql://", 0) == 0 || db.rfind("postgres://", 0) == 0;
 }
 
-std::unique_ptr<JobStore> open_postgres_store(const std::string& uri, WallClock clock) {
-  return std::make_unique<postgres::PostgresStore>(uri, std::move(clock));
+std::unique_ptr<JobStore> open_postgres_store(const std::string& uri, WallClock clock,
+                                              const std::filesystem::path& data_dir) {
+  return std::make_unique<postgres::PostgresStore>(uri, std::move(clock), data_dir);
 }
 
 }  // namespace hmpm::server

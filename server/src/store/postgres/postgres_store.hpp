@@ -11,18 +11,23 @@
 // database is meant to be shared.
 #pragma once
 
+#include <chrono>
+#include <filesystem>
+#include <mutex>
 #include <optional>
 #include <string>
 
 #include "connection.hpp"
 #include "hmpm/server/store.hpp"
+#include "store/write_probe.hpp"
 
 namespace hmpm::server::postgres {
 
 class PostgresStore final : public JobStore {
  public:
   /// See open_postgres_store in store.hpp.
-  PostgresStore(const std::string& uri, WallClock clock);
+  PostgresStore(const std::string& uri, WallClock clock,
+                const std::filesystem::path& data_dir = {});
 
   void probe() override;
   SubmitResult submit(const NewJob& job, std::int64_t max_queue) override;
@@ -52,8 +57,13 @@ class PostgresStore final : public JobStore {
   std::int64_t now_ms() const;   ///< now() as Unix ms
   std::int64_t lease_until(const Claimant& who) const;
 
+  /// Throws StoreFailure unless `data_dir` is the folder recorded in the
+  /// database (recorded here when none is yet).
+  void check_data_dir(PGconn* db, const std::filesystem::path& data_dir);
+
   WallClock clock_;
   ConnectionPool pool_;
+  WriteProbe write_probe_;  ///< probe()'s write, at most once a second
 };
 
 }  // namespace hmpm::server::postgres

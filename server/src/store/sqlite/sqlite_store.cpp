@@ -208,35 +208,21 @@ void SqliteStore::probe() {
   } catch (const StoreFailure& e) {
     throw StoreFailure(std::string("the database cannot be read: ") + e.what(), e.no_space());
   }
-  // The write: at most once a second (health checks may come far more
-  // often); in between, the last write's outcome stands.
-  const auto now = std::chrono::steady_clock::now();
-  {
-    std::lock_guard<std::mutex> lock(probe_mutex_);
-    if (now - last_write_probe_ < std::chrono::seconds(1)) {
-      if (!write_probe_error_.empty()) throw StoreFailure(write_probe_error_, write_probe_full_);
-      return;
+  write_probe_.check([&] {
+    ProbeOutcome outcome;
+    try {
+      WriteTransaction tx(db);
+      Statement s(db,
+                  "INSERT INTO store_probe (id, written) VALUES (1, ?1) "
+                  "ON CONFLICT (id) DO UPDATE SET written = excluded.written");
+      s.bind(1, now_text());
+      s.step();
+      tx.commit();
+    } catch (const StoreFailure& e) {
+      outcome = {std::string("the database cannot be written: ") + e.what(), e.no_space()};
     }
-    last_write_probe_ = now;
-  }
-  std::string error;
-  bool full = false;
-  try {
-    WriteTransaction tx(db);
-    Statement s(db,
-                "INSERT INTO store_probe (id, written) VALUES (1, ?1) "
-                "ON CONFLICT (id) DO UPDATE SET written = excluded.written");
-    s.bind(1, now_text());
-    s.step();
-    tx.commit();
-  } catch (const StoreFailure& e) {
-    error = std::string("the database cannot be written: ") + e.what();
-    full = e.no_space();
-  }
-  std::lock_guard<std::mutex> lock(probe_mutex_);
-  write_probe_error_ = error;
-  write_probe_full_ = full;
-  if (!error.empty()) throw StoreFailure(error, full);
+    return outcome;
+  });
 }
 
 SubmitResult SqliteStore::submit(const NewJob& job, std::int64_t max_queue) {

@@ -17,6 +17,7 @@
 #include "connection.hpp"
 #include "hmpm/server/store.hpp"
 #include "process_lock.hpp"
+#include "store/write_probe.hpp"
 
 namespace hmpm::server::sqlite {
 
@@ -56,11 +57,7 @@ class SqliteStore final : public JobStore {
   WallClock clock_;
   ProcessLock lock_;  ///< taken first, released last
   ConnectionPool pool_;
-  // probe(): when the last write probe ran and what it found ("" = written).
-  std::mutex probe_mutex_;
-  std::chrono::steady_clock::time_point last_write_probe_{};
-  std::string write_probe_error_;
-  bool write_probe_full_ = false;
+  WriteProbe write_probe_;  ///< probe()'s write, at most once a second
 };
 
 /// The lock file of the database at `db_path`: `<db_path>.lock`.
