@@ -33,7 +33,7 @@ class EnsembleRoutesTest : public ServiceTest {
     EXPECT_TRUE(res);
     if (!res) return {};
     EXPECT_EQ(res->status, 201) << res->body;
-    const Json doc = json_of(res->body);
+    Json doc = json_of(res->body);
     EXPECT_EQ(res->get_header_value("Location"), "/ensembles/" + doc.value("ensembleID", ""));
     return doc;
   }
@@ -237,6 +237,7 @@ TEST_F(EnsembleRoutesTest, SamplesRunAsJobsAndStatisticsEqualTheSamplesOwnSeries
     for (const char* field : {"displacement", "velocity"}) {
       for (std::size_t t = 0; t < times; ++t) {
         std::vector<double> v;
+        v.reserve(series.size());
         for (const Json& s : series) v.push_back(s["particles"][p][field][t][0].get<double>());
         const Json expected = figures(v);
         for (const char* f : {"mean", "std", "p05", "p50", "p95"}) {

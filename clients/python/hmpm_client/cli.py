@@ -168,19 +168,32 @@ def _download(job: Job, directory: str) -> None:
     print(f"{PROG}: downloaded {len(paths)} files to {directory} (sha256 verified)", file=sys.stderr)
 
 
-def cmd_submit(client: Client, args) -> int:
-    if args.spec == "-":
-        spec: Any = sys.stdin.buffer.read()
-    else:
-        if not Path(args.spec).is_file():
-            _err(f"{args.spec}: no such file")
-            return EXIT_INVALID
-        spec = args.spec
-    job = client.submit(spec, idempotency_key=args.idempotency_key)
-    print(job.id, flush=True)
-    for w in job.warnings:
+def _input(name: str) -> Any:
+    """What to submit: stdin's bytes for "-", else the file's path (None,
+    said on stderr, when there is no such file)."""
+    if name == "-":
+        return sys.stdin.buffer.read()
+    if not Path(name).is_file():
+        _err(f"{name}: no such file")
+        return None
+    return name
+
+
+def _submitted(handle: Any, args) -> bool:
+    """Prints a new job's or ensemble's id (stdout) and warnings (stderr);
+    whether to wait for it."""
+    print(handle.id, flush=True)
+    for w in handle.warnings:
         _err(f"warning: {w.get('path', '')}: {w.get('message', '')}")
-    if not (args.wait or args.download):
+    return bool(args.wait or args.download)
+
+
+def cmd_submit(client: Client, args) -> int:
+    spec = _input(args.spec)
+    if spec is None:
+        return EXIT_INVALID
+    job = client.submit(spec, idempotency_key=args.idempotency_key)
+    if not _submitted(job, args):
         return EXIT_OK
     doc = _wait(job, args)
     code = _finish(job, doc)
@@ -319,18 +332,11 @@ def cmd_ensemble(client: Client, args) -> int:
     from .ensemble import final_statistics, format_status
     action = args.ensemble_command
     if action == "submit":
-        if args.request == "-":
-            request: Any = sys.stdin.buffer.read()
-        elif not Path(args.request).is_file():
-            _err(f"{args.request}: no such file")
+        request = _input(args.request)
+        if request is None:
             return EXIT_INVALID
-        else:
-            request = args.request
         ens = client.submit_ensemble(request, idempotency_key=args.idempotency_key)
-        print(ens.id, flush=True)
-        for w in ens.warnings:
-            _err(f"warning: {w.get('path', '')}: {w.get('message', '')}")
-        if not (args.wait or args.download):
+        if not _submitted(ens, args):
             return EXIT_OK
         code = _ensemble_finish(ens.wait(progress=not args.quiet, timeout=args.timeout))
         if args.download:

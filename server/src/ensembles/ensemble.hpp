@@ -82,6 +82,7 @@ struct SampleState {
 };
 
 /// An ensemble's status and progress, derived from its samples'.
+// NOLINTNEXTLINE(bugprone-exception-escape): json's defaulted members (never throw for null)
 struct Summary {
   JobStatus status = JobStatus::accepted;
   double progress = 0.0;  ///< percent, 0..100
