@@ -35,6 +35,10 @@ const std::string ended_statuses = "(" + sql_name(JobStatus::successful) + "," +
                                    sql_name(JobStatus::failed) + "," +
                                    sql_name(JobStatus::dismissed) + ")";
 
+// Serialises ensemble submissions (their idempotency check and queue
+// count); a single job's submission is one lock-free statement.
+constexpr const char* ensemble_submit_lock = "SELECT pg_advisory_xact_lock(1752001902)";
+
 // The last column is an accepted job's place in the queue (1: next); in a
 // RETURNING clause the subquery sees the rows as they were before.
 const std::string job_columns =
@@ -685,7 +689,7 @@ EnsembleSubmitResult PostgresStore::submit_ensemble(const NewEnsemble& ensemble,
   auto connection = pool_.lease();
   PGconn* db = connection.get();
   Transaction tx(db);
-  exec(db, submit_lock);
+  exec(db, ensemble_submit_lock);
   if (!ensemble.idempotency_key.empty()) {
     const Result r = exec(db, "SELECT id, body_sha256 FROM ensembles WHERE idempotency_key = $1",
                           Params().add(ensemble.idempotency_key));
