@@ -253,6 +253,22 @@ double memory_bytes(const Problem& p, const CostEstimate& c, double threads) {
   if (p.shape_function == ShapeFunction::gimp) particle += 16;  // half_length, box_inverse
   if (fluid) particle += 8 * (3 + d);  // pressure, pressure_out, porosity, darcy
   if (plastic) particle += 8 * MemoryModel::plastic_state_variables;
+  // Varying parameters (solver/src/materials/varying.hpp): each value, and
+  // what it derives: Lame's constants (E), the whole strength constants (c,
+  // phi; Mohr-Coulomb's are 48 doubles), k/gamma_w (k). The fields are
+  // generated over the particles at set-up (a value and a lattice node each).
+  bool strength = false, any_varying = false;
+  for (const Material& m : p.materials)
+    for (const VaryingParameter& v : m.varying) {
+      any_varying = true;
+      particle += 8;
+      if (v.parameter == MaterialParameter::youngs_modulus) particle += 16;
+      if (v.parameter == MaterialParameter::hydraulic_conductivity) particle += 8;
+      strength = strength || v.parameter == MaterialParameter::cohesion ||
+                 v.parameter == MaterialParameter::friction_angle;
+    }
+  if (strength) particle += 8 * 48;
+  if (any_varying) particle += 8 * 4;
   // Scattered sums (mass, momentum, force, remap; storage, pressure, flux)
   // per node, in the grid and in every extra thread's buffer; the grid
   // also keeps velocity and acceleration (and dp).
@@ -283,10 +299,8 @@ double memory_bytes(const Problem& p, const CostEstimate& c, double threads) {
   // while the file is written.
   if (c.snapshots > 0) {
     double values = 2;  // volume, mass
-    if (o.snapshot_fields.empty())
-      for (const FieldInfo& f : field_table) values += field_components(f.field, 3);
-    else
-      for (Field f : o.snapshot_fields) values += field_components(f, 3);
+    for (Field f : o.snapshot_fields.empty() ? default_snapshot_fields(p) : o.snapshot_fields)
+      values += field_components(f, 3);
     bytes += particles * (8 * values + 4);
   }
   return bytes;
@@ -418,10 +432,8 @@ CostEstimate estimate_cost(const Problem& p, const Calibration& calibration) {
   // Snapshot arrays have 3 components per vector in every dimension; no
   // fields listed means every field.
   double snapshot_values = 2;  // volume, material
-  if (o.snapshot_fields.empty())
-    for (const FieldInfo& f : field_table) snapshot_values += field_components(f.field, 3);
-  else
-    for (Field f : o.snapshot_fields) snapshot_values += field_components(f, 3);
+  for (Field f : o.snapshot_fields.empty() ? default_snapshot_fields(p) : o.snapshot_fields)
+    snapshot_values += field_components(f, 3);
   // ~22 characters per number in series.json and again in series.csv;
   // base64 float64 in the VTU files is 8 * 4/3 bytes per number.
   const double bytes =

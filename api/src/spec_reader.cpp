@@ -309,6 +309,14 @@ bool SpecReader::array(const json& j, const std::string& path, std::size_t min_s
 
 std::optional<double> SpecReader::number(const json& j, const std::string& path,
                                          const Range& range) {
+  if (j.is_object() && j.contains("random_field")) {
+    // The parameters that may vary are read before they get here (parse/materials.cpp).
+    error(path,
+          "cannot vary: a random field is allowed only for a material's youngs_modulus, "
+          "cohesion, friction_angle and hydraulic.hydraulic_conductivity; expected a number " +
+              range.describe());
+    return std::nullopt;
+  }
   if (!j.is_number()) {
     error(path, "expected a number " + range.describe() + ", got " + j.type_name());
     return std::nullopt;

@@ -12,6 +12,12 @@
 namespace hmpm {
 
 template <int Dim, class Shape>
+double Simulation<Dim, Shape>::parameter_at(std::size_t p, MaterialParameter k) const {
+  const std::vector<double>& own = particles_.varying.value[static_cast<std::size_t>(k)];
+  return own.empty() ? parameter_of(model_.problem.materials[particles_.material[p]], k) : own[p];
+}
+
+template <int Dim, class Shape>
 void Simulation<Dim, Shape>::fill_snapshot(Snapshot& snap, const std::vector<Field>& fields) const {
   const std::size_t n = particles_.size();
   snap.dimension = Dim;
@@ -33,6 +39,10 @@ void Simulation<Dim, Shape>::fill_snapshot(Snapshot& snap, const std::vector<Fie
       out.assign(n, 0.0);
     else
       out.assign(in.begin(), in.end());
+  };
+  auto parameter_values = [&](std::vector<double>& out, MaterialParameter k) {
+    out.resize(n);
+    for (std::size_t p = 0; p < n; ++p) out[p] = parameter_at(p, k);
   };
   for (Field f : fields) {
     switch (f) {
@@ -66,6 +76,18 @@ void Simulation<Dim, Shape>::fill_snapshot(Snapshot& snap, const std::vector<Fie
         break;
       case Field::strain:
         voigt(snap.strain, particles_.strain);
+        break;
+      case Field::youngs_modulus:
+        parameter_values(snap.youngs_modulus, MaterialParameter::youngs_modulus);
+        break;
+      case Field::cohesion:
+        parameter_values(snap.cohesion, MaterialParameter::cohesion);
+        break;
+      case Field::friction_angle:
+        parameter_values(snap.friction_angle, MaterialParameter::friction_angle);
+        break;
+      case Field::hydraulic_conductivity:
+        parameter_values(snap.hydraulic_conductivity, MaterialParameter::hydraulic_conductivity);
         break;
       case Field::total_stress: {
         voigt(snap.total_stress, particles_.stress);
@@ -124,6 +146,12 @@ void Simulation<Dim, Shape>::sample_series(Series& series, double t) const {
           break;
         case Field::strain:
           for (int c = 0; c < 6; ++c) out.push_back(particles_.strain[p][c]);
+          break;
+        case Field::youngs_modulus:
+        case Field::cohesion:
+        case Field::friction_angle:
+        case Field::hydraulic_conductivity:
+          out.push_back(parameter_at(p, parameter_of_field(series.fields[f])));
           break;
         case Field::total_stress: {
           const double pw = particles_.pressure_out.empty() ? 0.0 : particles_.pressure_out[p];

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -16,6 +17,7 @@
 #include "boundary/constraints.hpp"
 #include "boundary/tractions.hpp"
 #include "geostatic.hpp"
+#include "materials/varying.hpp"
 #include "particle_layout.hpp"
 #include "simulation.hpp"
 
@@ -125,6 +127,62 @@ void Simulation<Dim, Shape>::setup_particles() {
       }
       ++p;
     }
+  }
+  setup_varying(layouts);
+}
+
+template <int Dim, class Shape>
+void Simulation<Dim, Shape>::setup_varying(const std::vector<BodyLayout>& layouts) {
+  const std::vector<Material>& materials = model_.problem.materials;
+  std::array<bool, material_parameter_count> varies{};
+  bool strength = false;
+  for (const Material& m : materials)
+    for (const VaryingParameter& v : m.varying) {
+      varies[static_cast<std::size_t>(v.parameter)] = true;
+      strength = strength || v.parameter == MaterialParameter::cohesion ||
+                 v.parameter == MaterialParameter::friction_angle;
+    }
+  if (std::none_of(varies.begin(), varies.end(), [](bool v) { return v; })) return;
+  interrupt_.stage("generating the random fields of material parameters");
+  // Each material's values at its particles, in the job's order (the
+  // particles are still in that order: stages move them later).
+  std::vector<std::vector<std::vector<double>>> values(materials.size());
+  for (std::size_t m = 0; m < materials.size(); ++m)
+    if (!materials[m].varying.empty()) values[m] = varying_values(model_.problem, m, layouts);
+  const std::size_t n = particles_.size();
+  VaryingConstants& out = particles_.varying;
+  for (int k = 0; k < material_parameter_count; ++k)
+    if (varies[static_cast<std::size_t>(k)]) out.value[static_cast<std::size_t>(k)].resize(n);
+  auto has_model = [&](Model model) {
+    return std::any_of(model_.constants.begin(), model_.constants.end(),
+                       [&](const MaterialConstants& c) { return c.model == model; });
+  };
+  if (varies[static_cast<std::size_t>(MaterialParameter::youngs_modulus)]) out.elastic.resize(n);
+  if (varies[static_cast<std::size_t>(MaterialParameter::hydraulic_conductivity)])
+    out.permeability_over_gamma.resize(n);
+  if (strength && has_model(Model::mohr_coulomb)) out.mohr_coulomb.resize(n);
+  if (strength && has_model(Model::drucker_prager)) out.drucker_prager.resize(n);
+  std::vector<Material> own = materials;               // a particle's material, its values set
+  std::vector<std::size_t> next(materials.size(), 0);  // each material's next particle
+  for (std::size_t p = 0; p < n; ++p) {
+    interrupt_.poll(p);
+    const std::uint16_t mat = particles_.material[p];
+    Material& m = own[mat];
+    const std::size_t j = next[mat]++;
+    for (std::size_t i = 0; i < m.varying.size(); ++i)
+      set_parameter(m, m.varying[i].parameter, values[mat][i][j]);
+    for (int k = 0; k < material_parameter_count; ++k)
+      if (!out.value[static_cast<std::size_t>(k)].empty())
+        out.value[static_cast<std::size_t>(k)][p] =
+            parameter_of(m, static_cast<MaterialParameter>(k));
+    const MaterialConstants c = m.varying.empty()
+                                    ? model_.constants[mat]
+                                    : material_constants(m, model_.problem.gravity_constant);
+    if (!out.elastic.empty()) out.elastic[p] = c.elastic;
+    if (!out.permeability_over_gamma.empty())
+      out.permeability_over_gamma[p] = c.permeability_over_gamma;
+    if (!out.mohr_coulomb.empty()) out.mohr_coulomb[p] = c.mohr_coulomb;
+    if (!out.drucker_prager.empty()) out.drucker_prager[p] = c.drucker_prager;
   }
 }
 

@@ -228,6 +228,9 @@ class Simulation {
   void setup_grid();
   void setup_materials();
   void setup_particles();
+  /// The particles' own constants of the parameters that vary (materials/
+  /// varying.hpp), from the fields over every body's particles.
+  void setup_varying(const std::vector<BodyLayout>& layouts);
   void setup_geostatic();
   /// Staged jobs: the particles of bodies a stage adds leave the run until
   /// then (set-up, before the geostatic state).
@@ -246,6 +249,9 @@ class Simulation {
   // ------------------------------------------------------------ output (output.hpp)
   void fill_snapshot(Snapshot& snap, const std::vector<Field>& fields) const;
   void sample_series(Series& series, double t) const;
+  /// Particle p's value of a material parameter: its own where it varies,
+  /// else its material's.
+  double parameter_at(std::size_t p, MaterialParameter k) const;
   /// Appends the excess pore pressure at time t to `c`
   /// (OutputRequest::consolidation): of every particle in the run when the
   /// request counts all, else of `counted` (job particle indices).

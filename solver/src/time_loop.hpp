@@ -136,8 +136,7 @@ RunResult Simulation<Dim, Shape>::run(const RunOptions& options) {
   }
   double next_reaction = out.reactions_interval;
   std::vector<Field> snapshot_fields = out.snapshot_fields;
-  if (snapshot_fields.empty())
-    for (int f = 0; f < field_count; ++f) snapshot_fields.push_back(static_cast<Field>(f));
+  if (snapshot_fields.empty()) snapshot_fields = default_snapshot_fields(job_);
   const bool want_snapshots = out.snapshot_interval > 0 && options.on_snapshot;
   Snapshot snap;
   std::vector<double> snapshot_times;  // of the snapshots taken, for checkpoints

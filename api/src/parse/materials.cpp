@@ -32,10 +32,30 @@ Keys material_key_names() {
   return keys;
 }
 
+// A parameter that may vary from particle to particle: a number in
+// `range`, or {"random_field": ...} (random_fields.cpp), recorded in
+// m.varying with the distribution's mean as the material's nominal value.
+std::optional<double> read_varying(ParseContext& c, Material& m, MaterialParameter k, const json& j,
+                                   const std::string& path, const Range& range) {
+  if (!j.is_object()) return c.r.number(j, path, range);
+  const std::optional<RandomField> f = read_random_field(c, j, path);
+  if (!f) return std::nullopt;
+  m.varying.push_back({k, *f, {}});
+  return f->mean();
+}
+
+// The model parameters that may vary.
+std::optional<MaterialParameter> varying_parameter(std::string_view key) {
+  if (key == "cohesion") return MaterialParameter::cohesion;
+  if (key == "friction_angle") return MaterialParameter::friction_angle;
+  return std::nullopt;
+}
+
 // The model's parameters: keys of other models refused, required ones
 // present, each read in table order and checked against those before it.
-Plasticity read_model(SpecReader& r, const MaterialModel& model, const json& j,
+Plasticity read_model(ParseContext& c, Material& mat, const MaterialModel& model, const json& j,
                       const std::string& path) {
+  SpecReader& r = c.r;
   const auto reads = [&](std::string_view key) {
     return std::any_of(model.parameters.begin(), model.parameters.end(),
                        [&](const ModelParameter& p) { return p.key == key; });
@@ -53,7 +73,9 @@ Plasticity read_model(SpecReader& r, const MaterialModel& model, const json& j,
     values.push_back(p.fallback);
     if (!j.contains(p.key)) continue;
     const std::string pp = child_pointer(path, p.key);
-    if (auto v = r.number(j[std::string(p.key)], pp, p.range)) {
+    const json& value = j[std::string(p.key)];
+    const std::optional<MaterialParameter> k = varying_parameter(p.key);
+    if (auto v = k ? read_varying(c, mat, *k, value, pp, p.range) : r.number(value, pp, p.range)) {
       values.back() = *v;
       if (p.check)
         if (std::string why = p.check(*v, std::span(values).first(values.size() - 1)); !why.empty())
@@ -63,13 +85,15 @@ Plasticity read_model(SpecReader& r, const MaterialModel& model, const json& j,
   return model.build(values);
 }
 
-void read_hydraulic(SpecReader& r, Material& m, const json& j, const std::string& path) {
+void read_hydraulic(ParseContext& c, Material& m, const json& j, const std::string& path) {
+  SpecReader& r = c.r;
   if (!r.object(j, path, hydraulic_allowed, hydraulic_required)) return;
   Hydraulic h;
   r.number_at(j, path, "porosity", {0.0, 1.0, true, true}, h.porosity);
   if (j.contains("hydraulic_conductivity"))
-    if (auto v = r.number(j["hydraulic_conductivity"], path + "/hydraulic_conductivity",
-                          Range::non_negative()))
+    if (auto v = read_varying(c, m, MaterialParameter::hydraulic_conductivity,
+                              j["hydraulic_conductivity"], path + "/hydraulic_conductivity",
+                              Range::non_negative()))
       h.hydraulic_conductivity = *v;
   r.number_at(j, path, "fluid_bulk_modulus", Range::positive(), h.fluid_bulk_modulus);
   r.number_at(j, path, "fluid_density", Range::positive(), h.fluid_density);
@@ -88,7 +112,10 @@ void read_material(ParseContext& c, const std::string& name, const json& j,
     r.error(path, "material names must have 1 to 100 characters");
   if (r.object(j, path, material_key_names(), material_required)) {
     r.number_at(j, path, "density", Range::positive(), m.density);
-    r.number_at(j, path, "youngs_modulus", Range::positive(), m.youngs_modulus);
+    if (j.contains("youngs_modulus"))
+      if (auto v = read_varying(c, m, MaterialParameter::youngs_modulus, j["youngs_modulus"],
+                                path + "/youngs_modulus", Range::positive()))
+        m.youngs_modulus = *v;
     if (j.contains("poisson_ratio")) {
       const json& v = j["poisson_ratio"];
       const std::string vp = path + "/poisson_ratio";
@@ -103,8 +130,8 @@ void read_material(ParseContext& c, const std::string& name, const json& j,
     if (j.contains("model"))
       if (auto s = r.one_of(j["model"], path + "/model", material_model_names()))
         model = find_material_model(*s);
-    m.plasticity = read_model(r, *model, j, path);
-    if (j.contains("hydraulic")) read_hydraulic(r, m, j["hydraulic"], path + "/hydraulic");
+    m.plasticity = read_model(c, m, *model, j, path);
+    if (j.contains("hydraulic")) read_hydraulic(c, m, j["hydraulic"], path + "/hydraulic");
   }
   c.material_index[name] = static_cast<int>(c.p.materials.size());
   c.p.materials.push_back(std::move(m));

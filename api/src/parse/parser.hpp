@@ -106,6 +106,9 @@ struct ParseContext {
 void read_grid(ParseContext& c, const json& j, const std::string& path);
 void read_shape_function(ParseContext& c, const json& j, const std::string& path);
 void read_materials(ParseContext& c, const json& j, const std::string& path);
+/// A material parameter given as {"random_field": {...}} (random_fields.cpp).
+std::optional<RandomField> read_random_field(ParseContext& c, const json& j,
+                                             const std::string& path);
 void read_bodies(ParseContext& c, const json& j, const std::string& path);
 void read_boundaries(ParseContext& c, const json& j, const std::string& path);
 void read_tractions(ParseContext& c, const json& j, const std::string& path);

@@ -132,6 +132,14 @@ const std::vector<double>* snapshot_array(const Snapshot& s, Field f) {
       return &s.porosity;
     case Field::plastic_strain:
       return &s.plastic_strain;
+    case Field::youngs_modulus:
+      return &s.youngs_modulus;
+    case Field::cohesion:
+      return &s.cohesion;
+    case Field::friction_angle:
+      return &s.friction_angle;
+    case Field::hydraulic_conductivity:
+      return &s.hydraulic_conductivity;
   }
   return nullptr;
 }

@@ -29,6 +29,14 @@ enum class Field : std::uint8_t {
   porosity,
   total_stress,
   plastic_strain,
+  // A material parameter's value at the particle (MaterialParameter,
+  // problem.hpp, in the same order): the particle's own where the parameter
+  // varies (random fields), else its material's. In the default snapshot
+  // fields only when some material varies it.
+  youngs_modulus,
+  cohesion,
+  friction_angle,
+  hydraulic_conductivity,
 };
 
 /// scalar: 1 component; vector: one per axis (dim); tensor: 6 in Voigt
@@ -43,7 +51,7 @@ struct FieldInfo {
 };
 
 /// Every field, in the order of the Field enumerators.
-inline constexpr std::array<FieldInfo, 10> field_table{{
+inline constexpr std::array<FieldInfo, 14> field_table{{
     {Field::position, "position", FieldKind::vector, "m"},
     {Field::displacement, "displacement", FieldKind::vector, "m"},
     {Field::velocity, "velocity", FieldKind::vector, "m/s"},
@@ -56,6 +64,13 @@ inline constexpr std::array<FieldInfo, 10> field_table{{
     // Accumulated equivalent plastic strain, sum of sqrt(2/3 deps_p : deps_p)
     // over the steps (zero for elastic materials).
     {Field::plastic_strain, "plastic_strain", FieldKind::scalar, "-"},
+    // The material parameters (0 where the particle's material has none:
+    // cohesion and friction angle of a linear-elastic material, the
+    // hydraulic conductivity of a dry one).
+    {Field::youngs_modulus, "youngs_modulus", FieldKind::scalar, "Pa"},
+    {Field::cohesion, "cohesion", FieldKind::scalar, "Pa"},
+    {Field::friction_angle, "friction_angle", FieldKind::scalar, "deg"},
+    {Field::hydraulic_conductivity, "hydraulic_conductivity", FieldKind::scalar, "m/s"},
 }};
 inline constexpr int field_count = static_cast<int>(field_table.size());
 
@@ -65,6 +80,11 @@ constexpr bool field_table_is_in_enum_order() {
   return true;
 }
 static_assert(field_table_is_in_enum_order(), "field_table rows must follow the Field enumerators");
+
+/// The fields of the material parameters: youngs_modulus and after.
+constexpr bool is_material_parameter_field(Field f) {
+  return f >= Field::youngs_modulus && f <= Field::hydraulic_conductivity;
+}
 
 /// What field_info gives for a value outside the enumerators: "?", one component.
 inline constexpr FieldInfo unknown_field{Field::position, "?", FieldKind::scalar, ""};

@@ -22,6 +22,7 @@
 #include <vector>
 
 #include "hmpm/fields.hpp"
+#include "hmpm/random_field.hpp"
 
 namespace hmpm {
 
@@ -91,6 +92,33 @@ struct DruckerPrager {
 
 using Plasticity = std::variant<LinearElastic, MohrCoulomb, DruckerPrager>;
 
+/// A material parameter that may vary from particle to particle (each has
+/// its output field of the same name, fields.hpp). Cam-Clay's
+/// preconsolidation pressure would join as the initial value of its state
+/// variable (materials/varying.hpp says where).
+enum class MaterialParameter : std::uint8_t {
+  youngs_modulus,          ///< Pa
+  cohesion,                ///< Pa (mohr_coulomb, drucker_prager)
+  friction_angle,          ///< degrees (mohr_coulomb, drucker_prager)
+  hydraulic_conductivity,  ///< m/s (materials with hydraulic)
+};
+inline constexpr int material_parameter_count = 4;
+
+/// A parameter's value at each particle of a material: a spatially
+/// correlated random field (random_field.hpp) generated once, at set-up,
+/// over the initial positions of every particle of every body of the
+/// material (bodies a stage adds included, so a fill of the same material
+/// continues the ground's field), in the job's particle order; or a
+/// function of the particle's initial position. The Material's own number
+/// for the parameter is then its nominal value (the field's mean): what
+/// the material-level uses read (absorbing boundaries' impedance,
+/// plausibility warnings), not the particles.
+struct VaryingParameter {
+  MaterialParameter parameter = MaterialParameter::youngs_modulus;
+  std::optional<RandomField> random_field;
+  FieldOfPosition value;  ///< used when random_field is absent
+};
+
 struct Material {
   std::string name;  ///< for messages only
   /// Bulk density (dry material) or grain density rho_s (with hydraulic).
@@ -99,6 +127,9 @@ struct Material {
   double poisson_ratio = 0.0;
   Plasticity plasticity = LinearElastic{};
   std::optional<Hydraulic> hydraulic;
+  /// Parameters that vary from particle to particle, each at most once
+  /// (check_problem); empty: the material is homogeneous.
+  std::vector<VaryingParameter> varying;
 };
 
 /// Initial fields of a body; each entry is a function of the particle's

@@ -75,6 +75,10 @@ struct StableStep {
 /// Estimates the stable step for `problem` (automatic or user dt).
 StableStep stable_step(const Problem& problem);
 
+/// The snapshot fields when the output lists none: every field, a material
+/// parameter's (Field::youngs_modulus ...) only when some material varies it.
+std::vector<Field> default_snapshot_fields(const Problem& problem);
+
 /// Checks a Problem for anything the solver cannot run: dimensions,
 /// positive moduli and densities, boxes inside the grid, a user dt above the
 /// stable limit (refused, with the limit in the message), empty bodies.
@@ -169,9 +173,11 @@ struct Snapshot {
   std::vector<double> strain;            ///< 6
   std::vector<double> porosity;          ///< 1
   std::vector<double> plastic_strain;    ///< 1, accumulated equivalent plastic strain
-  std::vector<double> volume;            ///< 1, always filled
-  std::vector<double> mass;              ///< 1, always filled
-  std::vector<int> material;             ///< 1, always filled
+  /// 1 each: the material parameters at the particles (Field::youngs_modulus ...).
+  std::vector<double> youngs_modulus, cohesion, friction_angle, hydraulic_conductivity;
+  std::vector<double> volume;  ///< 1, always filled
+  std::vector<double> mass;    ///< 1, always filled
+  std::vector<int> material;   ///< 1, always filled
 };
 
 /// Time histories of the selected particles. `values[f]` holds, for field

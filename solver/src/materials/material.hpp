@@ -28,6 +28,7 @@
 #include "hmpm/problem.hpp"
 #include "linear_elastic.hpp"
 #include "mohr_coulomb.hpp"
+#include "varying.hpp"
 
 namespace hmpm {
 
@@ -111,32 +112,50 @@ inline MaterialConstants material_constants(const Material& m, double gravity_co
   return c;
 }
 
-/// The u-p equations with Darcy's rho_f a term are not dissipative: one
-/// Fourier mode of the 1D equations has the characteristic polynomial
-///   rho Q s^3 + rho k' q^2 s^2 + q^2 (E Q + 1) s + E k q^4,
-/// (k = k/gamma_w, k' = k (1 - rho_f/rho), E the constrained modulus), and
-/// Routh-Hurwitz makes every mode grow when E Q > (rho - rho_f)/rho_f, for
-/// any wavenumber and any permeability > 0. This returns
-/// E Q rho_f / (rho - rho_f): above 1 the material is in that regime
-/// (infinity when the grains are not denser than the fluid), 0 when the
-/// term is dropped or nothing flows.
 /// Plastic correction of the elastic trial stress (effective stress, so dry
 /// and saturated alike): the closed-form return mapping of the material's
 /// model; linear-elastic materials in a run with plastic ones pass through.
 /// `state` is the particle's internal state variables (materials/ models
 /// that declare none ignore it). Returns ||d eps_p|| (the Frobenius norm of
 /// the plastic strain increment, tensor components), 0 when elastic.
+/// For particle p, whose parameters may vary (materials/varying.hpp): `el`
+/// is the elasticity of its trial, and its strength constants are its own
+/// where `varying` has them.
 inline double return_to_yield_surface(constitutive::Voigt& sig, const MaterialConstants& mc,
+                                      const constitutive::Elastic& el,
+                                      const VaryingConstants& varying, std::size_t p,
                                       [[maybe_unused]] InternalState state) {
   switch (mc.model) {
     case Model::mohr_coulomb:
-      return constitutive::return_mohr_coulomb(sig, mc.elastic, mc.mohr_coulomb);
+      return constitutive::return_mohr_coulomb(
+          sig, el, varying.mohr_coulomb.empty() ? mc.mohr_coulomb : varying.mohr_coulomb[p]);
     case Model::drucker_prager:
-      return constitutive::return_drucker_prager(sig, mc.elastic, mc.drucker_prager);
+      return constitutive::return_drucker_prager(
+          sig, el, varying.drucker_prager.empty() ? mc.drucker_prager : varying.drucker_prager[p]);
     case Model::linear_elastic:
       break;
   }
   return 0.0;
+}
+
+/// Particle p's elasticity: its own where E varies, else its material's.
+inline const constitutive::Elastic& elastic_of(const MaterialConstants& mc,
+                                               const VaryingConstants& varying, std::size_t p) {
+  return varying.elastic.empty() ? mc.elastic : varying.elastic[p];
+}
+
+/// Particle p's k / (rho_f g): its own where k varies, else its material's.
+inline double permeability_of(const MaterialConstants& mc, const VaryingConstants& varying,
+                              std::size_t p) {
+  return varying.permeability_over_gamma.empty() ? mc.permeability_over_gamma
+                                                 : varying.permeability_over_gamma[p];
+}
+
+/// The same for a material's own constants (a homogeneous material).
+inline double return_to_yield_surface(constitutive::Voigt& sig, const MaterialConstants& mc,
+                                      InternalState state) {
+  static const VaryingConstants homogeneous;
+  return return_to_yield_surface(sig, mc, mc.elastic, homogeneous, 0, state);
 }
 
 /// The increment of the accumulated equivalent plastic strain,
@@ -162,22 +181,44 @@ inline constitutive::Tangent elastic_tangent(const MaterialConstants& mc) {
 /// Returns ||d eps_p||, 0 when the step was elastic. Not for hot loops of
 /// the explicit scheme: it costs a spectral derivative per plastic point.
 inline double return_with_tangent(constitutive::Voigt& sig, const MaterialConstants& mc,
-                                  [[maybe_unused]] InternalState state,
+                                  InternalState state, constitutive::Tangent& d_alg);
+
+/// return_with_tangent for particle p, whose parameters may vary (as
+/// return_to_yield_surface above).
+inline double return_with_tangent(constitutive::Voigt& sig, const MaterialConstants& mc,
+                                  const constitutive::Elastic& el, const VaryingConstants& varying,
+                                  std::size_t p, [[maybe_unused]] InternalState state,
                                   constitutive::Tangent& d_alg) {
   switch (mc.model) {
     case Model::mohr_coulomb:
-      return constitutive::return_mohr_coulomb_with_tangent(sig, mc.elastic, mc.mohr_coulomb,
-                                                            d_alg);
+      return constitutive::return_mohr_coulomb_with_tangent(
+          sig, el, varying.mohr_coulomb.empty() ? mc.mohr_coulomb : varying.mohr_coulomb[p], d_alg);
     case Model::drucker_prager:
-      return constitutive::return_drucker_prager_with_tangent(sig, mc.elastic, mc.drucker_prager,
-                                                              d_alg);
+      return constitutive::return_drucker_prager_with_tangent(
+          sig, el, varying.drucker_prager.empty() ? mc.drucker_prager : varying.drucker_prager[p],
+          d_alg);
     case Model::linear_elastic:
       break;
   }
-  d_alg = constitutive::elastic_tangent(mc.elastic);
+  d_alg = constitutive::elastic_tangent(el);
   return 0.0;
 }
 
+inline double return_with_tangent(constitutive::Voigt& sig, const MaterialConstants& mc,
+                                  InternalState state, constitutive::Tangent& d_alg) {
+  static const VaryingConstants homogeneous;
+  return return_with_tangent(sig, mc, mc.elastic, homogeneous, 0, state, d_alg);
+}
+
+/// The u-p equations with Darcy's rho_f a term are not dissipative: one
+/// Fourier mode of the 1D equations has the characteristic polynomial
+///   rho Q s^3 + rho k' q^2 s^2 + q^2 (E Q + 1) s + E k q^4,
+/// (k = k/gamma_w, k' = k (1 - rho_f/rho), E the constrained modulus), and
+/// Routh-Hurwitz makes every mode grow when E Q > (rho - rho_f)/rho_f, for
+/// any wavenumber and any permeability > 0. This returns
+/// E Q rho_f / (rho - rho_f): above 1 the material is in that regime
+/// (infinity when the grains are not denser than the fluid), 0 when the
+/// term is dropped or nothing flows.
 inline double darcy_inertia_growth_ratio(const MaterialConstants& c) {
   if (!c.saturated || c.darcy_inertia_density <= 0.0 || c.permeability_over_gamma <= 0.0)
     return 0.0;

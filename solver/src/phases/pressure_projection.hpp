@@ -75,7 +75,7 @@ inline void map_predicted_fluid_flux(StepContext<Dim, Shape>& ctx, const Scatter
       grad_p += ctx.grid.pressure[i] * s.grad(k);
       a += s.w[k] * ctx.grid.accel[i];
     }
-    const Vec w = -mc.permeability_over_gamma *
+    const Vec w = -permeability_of(mc, ctx.particles.varying, p) *
                   (grad_p - mc.fluid_density * ctx.model.gravity + mc.darcy_inertia_density * a);
     const double vol = ctx.particles.volume[p];
     for (int k = 0; k < StencilT::N; ++k)
@@ -124,7 +124,7 @@ inline void assemble_pressure_laplacian(StepContext<Dim, Shape>& ctx, std::size_
     ctx.template stencil_in_step<true, true>(p, s);
     const double vol = ctx.particles.volume[p];
     const double rho = ctx.particles.mass[p] / vol;
-    const double c = vol * (dt * dt / rho + dt * mc.permeability_over_gamma *
+    const double c = vol * (dt * dt / rho + dt * permeability_of(mc, ctx.particles.varying, p) *
                                                 (1.0 - mc.darcy_inertia_density / rho));
     for (int k = 0; k < StencilT::N; ++k) {
       const std::int64_t i = s.node[k];

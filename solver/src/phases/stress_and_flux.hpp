@@ -32,6 +32,13 @@ inline void update_particle_stress_and_fluid_flux(StepContext<Dim, Shape>& ctx,
   AxesAhead ahead;
   // A local copy (Eigen's stores may alias the pointer for the compiler).
   double* const flux_out = Fluid && ScatterFlux ? at<nodal::flux>(out) : nullptr;
+  // Per-particle constants where parameters vary (null: every particle
+  // takes its material's; materials/varying.hpp).
+  const VaryingConstants& varying = ctx.particles.varying;
+  const constitutive::Elastic* const own_elastic =
+      varying.elastic.empty() ? nullptr : varying.elastic.data();
+  const double* const own_permeability =
+      varying.permeability_over_gamma.empty() ? nullptr : varying.permeability_over_gamma.data();
   for (std::size_t p = begin; p < end; ++p) {
     const auto& f = ctx.template axes_ahead<true>(p, begin, end, ahead);
     Mat grad_v = Mat::Zero();
@@ -89,10 +96,11 @@ inline void update_particle_stress_and_fluid_flux(StepContext<Dim, Shape>& ctx,
         }
       }
       // Component by component (an expression template here was left out of line).
+      const double k = own_permeability ? own_permeability[p] : mc.permeability_over_gamma;
       Vec w;
       for (int c = 0; c < Dim; ++c)
-        w[c] = -mc.permeability_over_gamma * (grad_p[c] - mc.fluid_density * ctx.model.gravity[c] +
-                                              mc.darcy_inertia_density * a[c]);
+        w[c] = -k * (grad_p[c] - mc.fluid_density * ctx.model.gravity[c] +
+                     mc.darcy_inertia_density * a[c]);
       ctx.particles.darcy[p] = w;
       if constexpr (ScatterFlux) {
         if constexpr (StencilT::factorised) {
@@ -126,14 +134,16 @@ inline void update_particle_stress_and_fluid_flux(StepContext<Dim, Shape>& ctx,
     Voigt& sig = ctx.particles.stress[p];
     if constexpr (Dim >= 2) rotate_jaumann<Dim>(sig, grad_v, dt);
     // Constants copied first: the stores to sig could alias mc for the compiler.
-    const double lambda_tr = mc.lambda * tr, two_g = 2.0 * mc.shear_modulus;
+    const constitutive::Elastic& el = own_elastic ? own_elastic[p] : mc.elastic;
+    const double lambda_tr = el.lambda * tr, two_g = 2.0 * el.shear;
     // Below 3D the shear increments yz and zx (in 1D also xy) are zero:
     // the loops end before them (components 0..changed_end-1 can change).
     constexpr int changed_end = Dim == 1 ? 3 : (Dim == 2 ? 4 : 6);
     for (int c = 0; c < 3; ++c) sig[c] += lambda_tr + two_g * de[c];
     for (int c = 3; c < changed_end; ++c) sig[c] += two_g * de[c];
     if constexpr (Plastic) {
-      const double plastic = return_to_yield_surface(sig, mc, {ctx.particles.internal.data(), p});
+      const double plastic =
+          return_to_yield_surface(sig, mc, el, varying, p, {ctx.particles.internal.data(), p});
       if (plastic > 0.0) ctx.particles.plastic_strain[p] += equivalent_plastic_strain(plastic);
     }
     for (int c = 0; c < changed_end; ++c) ctx.particles.strain[p][c] += de[c];

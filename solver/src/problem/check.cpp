@@ -4,6 +4,7 @@
 // every stage in force. The boundaries' own checks are in boundary/check.cpp;
 // the warnings for runnable but doubtful values in problem/warnings.cpp.
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <string>
 
@@ -13,6 +14,7 @@
 #include "hmpm/format.hpp"
 #include "hmpm/problem.hpp"
 #include "hmpm/run.hpp"
+#include "materials/varying.hpp"
 #include "particle_layout.hpp"
 #include "schemes/time_scheme.hpp"
 
@@ -33,6 +35,86 @@ const char* status_name(RunStatus s) {
 StableStep stable_step(const Problem& problem) {
   return scheme_rules(problem).stable_step(problem);
 }
+
+namespace {
+
+/// Where the job spec gives a material parameter.
+Location parameter_location(const Material& m, MaterialParameter k) {
+  const Location w{"materials", m.name};
+  return k == MaterialParameter::hydraulic_conductivity ? w / "hydraulic" / parameter_name(k)
+                                                        : w / parameter_name(k);
+}
+
+/// A random field's own numbers.
+void check_random_field(const RandomField& f, int dim, const Location& w,
+                        std::vector<ProblemIssue>& issues) {
+  const Location d = w / "random_field" / "distribution";
+  switch (f.distribution) {
+    case RandomField::Distribution::lognormal:
+      if (!(f.first > 0)) issues.push_back({d / "lognormal" / "mean", "must be > 0"});
+      if (!(f.second >= 0 && std::isfinite(f.second)))
+        issues.push_back({d / "lognormal" / "cov", "must be >= 0"});
+      break;
+    case RandomField::Distribution::normal:
+      if (!std::isfinite(f.first)) issues.push_back({d / "normal" / "mean", "must be finite"});
+      if (!(f.second >= 0 && std::isfinite(f.second)))
+        issues.push_back({d / "normal" / "std", "must be >= 0"});
+      break;
+    case RandomField::Distribution::uniform:
+      if (!(std::isfinite(f.first) && std::isfinite(f.second) && f.first <= f.second))
+        issues.push_back({d / "uniform", "needs finite min <= max"});
+      break;
+  }
+  for (int a = 0; a < dim; ++a)
+    if (!(f.correlation_length[static_cast<std::size_t>(a)] > 0))
+      issues.push_back(
+          {w / "random_field" / "correlation_length" / static_cast<std::size_t>(a), "must be > 0"});
+}
+
+/// Varying material parameters: each once, of a parameter the material
+/// has, and every particle's value in the parameter's range (the fields
+/// generated here as the run will: a normal field can leave it).
+void check_varying(const Problem& problem, std::vector<ProblemIssue>& issues) {
+  const std::size_t before = issues.size();
+  bool any = false;
+  for (const Material& m : problem.materials) {
+    std::array<bool, material_parameter_count> seen{};
+    for (const VaryingParameter& v : m.varying) {
+      any = true;
+      const Location w = parameter_location(m, v.parameter);
+      if (seen[static_cast<std::size_t>(v.parameter)]) issues.push_back({w, "varies twice"});
+      seen[static_cast<std::size_t>(v.parameter)] = true;
+      if (!parameter_applies(m, v.parameter))
+        issues.push_back({w, "does not apply to this material, so it cannot vary"});
+      if (v.random_field) check_random_field(*v.random_field, problem.dimension, w, issues);
+    }
+  }
+  if (!any || issues.size() > before) return;
+  const std::vector<BodyLayout> layouts = body_layouts(problem);
+  for (std::size_t i = 0; i < problem.materials.size(); ++i) {
+    const Material& m = problem.materials[i];
+    if (m.varying.empty()) continue;
+    const std::vector<std::vector<double>> values = varying_values(problem, i, layouts);
+    for (std::size_t k = 0; k < m.varying.size(); ++k) {
+      const MaterialParameter parameter = m.varying[k].parameter;
+      for (double value : values[k]) {
+        const std::string why = parameter_range_issue(parameter, value);
+        if (why.empty()) continue;
+        issues.push_back(
+            {parameter_location(m, parameter),
+             "takes the value " + format_significant(value, 4) + " at a particle, which " + why +
+                 (m.varying[k].random_field && m.varying[k].random_field->distribution ==
+                                                   RandomField::Distribution::normal
+                      ? ": a normal distribution is unbounded; use a lognormal one (always "
+                        "positive) or a uniform one within the range"
+                      : "")});
+        break;
+      }
+    }
+  }
+}
+
+}  // namespace
 
 /// A polygon must have 3 or more vertices, no repeated vertex, non-zero
 /// area and no crossing or touching edges.
@@ -360,6 +442,7 @@ std::vector<ProblemIssue> check_problem(const Problem& problem) {
       check_selection_polygon(problem, *problem.fluxes[i].polygon,
                               Location{"fluxes"} / i / "particles" / "polygon", issues);
   if (issues.size() > before_shapes) return issues;
+  check_varying(problem, issues);
   const std::vector<BodyLayout> layouts = body_layouts(problem, LayoutDetail::counts);
   for (std::size_t b = 0; b < problem.bodies.size(); ++b) {
     const Body& body = problem.bodies[b];

@@ -10,6 +10,7 @@
 #include "hmpm/problem.hpp"
 #include "hmpm/run.hpp"
 #include "materials/material.hpp"
+#include "materials/varying.hpp"
 #include "particle_layout.hpp"
 #include "schemes/time_scheme.hpp"
 
@@ -43,9 +44,12 @@ StableStep explicit_stable_step(const Problem& problem) {
   s.mechanical = std::numeric_limits<double>::infinity();
   s.hydraulic = std::numeric_limits<double>::infinity();
   const std::vector<bool> with_particles = materials_with_particles(problem);
-  for (std::size_t i = 0; i < problem.materials.size(); ++i) {
+  // Varying parameters at their largest: the stiffest particle's wave and
+  // the most conductive particle's diffusion limit the step.
+  const std::vector<Material> limiting = limiting_materials(problem);
+  for (std::size_t i = 0; i < limiting.size(); ++i) {
     if (!with_particles[i]) continue;
-    const Material& m = problem.materials[i];
+    const Material& m = limiting[i];
     const MaterialConstants mc = material_constants(m, problem.gravity_constant);
     const double c = std::sqrt(mc.undrained_p_modulus / mc.mixture_density);
     s.wave_speed = std::max(s.wave_speed, c);

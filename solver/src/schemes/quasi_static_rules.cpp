@@ -21,6 +21,7 @@
 #include "hmpm/problem.hpp"
 #include "hmpm/run.hpp"
 #include "materials/material.hpp"
+#include "materials/varying.hpp"
 #include "particle_layout.hpp"
 #include "schemes/quasi_static_plan.hpp"
 #include "schemes/time_scheme.hpp"
@@ -34,7 +35,8 @@ StepGrowth quasi_static_growth(const Problem& problem) {
   g.max = end / 20.0;
   g.growth = 1.2;
   double cv = 0.0;
-  for (const Material& m : problem.materials) {
+  // Varying parameters at their largest (the fastest diffusion sets the first step).
+  for (const Material& m : limiting_materials(problem)) {
     if (!m.hydraulic) continue;
     const MaterialConstants mc = material_constants(m, problem.gravity_constant);
     cv = std::max(cv, mc.permeability_over_gamma / (1.0 / mc.constrained_modulus + mc.storage));
@@ -65,7 +67,7 @@ StableStep quasi_static_stable_step(const Problem& problem) {
   const double end = problem.time.end - problem.time.start;  // the stage's length
   // Unconditionally stable: no limit below the whole run.
   s.mechanical = s.hydraulic = s.limit = end;
-  for (const Material& m : problem.materials) {
+  for (const Material& m : limiting_materials(problem)) {
     const MaterialConstants mc = material_constants(m, problem.gravity_constant);
     s.wave_speed = std::max(s.wave_speed, std::sqrt(mc.constrained_modulus / mc.mixture_density));
   }

@@ -326,7 +326,7 @@ class QuasiStaticScheme final : public TimeScheme {
         for (int j = 0; j < N; ++j) m(i, j) += v * s.w[i] * s.w[j];
       }
       vol += v;
-      tau = std::max(tau, factor / (2.0 * mc.shear_modulus));
+      tau = std::max(tau, factor / (2.0 * elastic_of(mc, parts.varying, p).shear));
     }
     if (!(vol > 0)) return;
     m -= mv * mv.transpose() / vol;
@@ -457,12 +457,16 @@ class QuasiStaticScheme final : public TimeScheme {
     sig = c_.particles.stress[p];
     if constexpr (Dim >= 2) rotate_jaumann<Dim>(sig, g, 1.0);
     const double tr = de[0] + de[1] + de[2];
-    for (int c = 0; c < 3; ++c) sig[c] += mc.lambda * tr + 2.0 * mc.shear_modulus * de[c];
-    for (int c = 3; c < 6; ++c) sig[c] += 2.0 * mc.shear_modulus * de[c];
+    const VaryingConstants& varying = c_.particles.varying;
+    const constitutive::Elastic& el = elastic_of(mc, varying, p);
+    for (int c = 0; c < 3; ++c) sig[c] += el.lambda * tr + 2.0 * el.shear * de[c];
+    for (int c = 3; c < 6; ++c) sig[c] += 2.0 * el.shear * de[c];
     if (!c_.model.plastic) return false;
     if (d_alg && mc.model != Model::linear_elastic)
-      return return_with_tangent(sig, mc, {c_.particles.internal.data(), p}, *d_alg) > 0.0;
-    const double norm = return_to_yield_surface(sig, mc, {c_.particles.internal.data(), p});
+      return return_with_tangent(sig, mc, el, varying, p, {c_.particles.internal.data(), p},
+                                 *d_alg) > 0.0;
+    const double norm =
+        return_to_yield_surface(sig, mc, el, varying, p, {c_.particles.internal.data(), p});
     if (plastic) *plastic = norm;
     return false;
   }
@@ -640,7 +644,7 @@ class QuasiStaticScheme final : public TimeScheme {
       const double storage = sat ? (1.0 - parts.porosity[p]) * c_.model.inv_ks[parts.material[p]] +
                                        parts.porosity[p] * c_.model.inv_kf[parts.material[p]]
                                  : 0.0;
-      const double kg = sat ? mc.permeability_over_gamma : 0.0;
+      const double kg = sat ? permeability_of(mc, parts.varying, p) : 0.0;
       const Vec flow = grad_p - mc.fluid_density * gravity;
       const double p_old = sat ? parts.pressure_out[p] : 0.0;
       for (int k = 0; k < N; ++k) {
@@ -669,7 +673,8 @@ class QuasiStaticScheme final : public TimeScheme {
       if (!jacobian) continue;
       // Local Jacobian, scaled as in the file comment: the elastic
       // stiffness (lambda, G), or at plastic points the algorithmic tangent.
-      const double lam = mc.lambda * vol * inv_e, sh = mc.shear_modulus * vol * inv_e;
+      const constitutive::Elastic& el = elastic_of(mc, parts.varying, p);
+      const double lam = el.lambda * vol * inv_e, sh = el.shear * vol * inv_e;
       if (plastic) {
         Eigen::Matrix<double, NC, NC> dr;
         for (int i = 0; i < NC; ++i)
@@ -799,7 +804,7 @@ class QuasiStaticScheme final : public TimeScheme {
         parts.pressure[p] = p_hat;
         parts.pressure_out[p] = p_hat;
         parts.darcy[p] =
-            -mc.permeability_over_gamma * (grad_p - mc.fluid_density * c_.model.gravity);
+            -permeability_of(mc, parts.varying, p) * (grad_p - mc.fluid_density * c_.model.gravity);
         if (!std::isfinite(p_hat)) c_.failures.nonfinite(p, "pore pressure");
       }
       parts.v[p] = dx / h;

@@ -19,6 +19,7 @@
 #include "hmpm/problem.hpp"
 #include "hmpm/run.hpp"
 #include "materials/material.hpp"
+#include "materials/varying.hpp"
 #include "particle_layout.hpp"
 #include "schemes/time_scheme.hpp"
 
@@ -33,9 +34,11 @@ StableStep semi_implicit_stable_step(const Problem& problem) {
   s.mechanical = std::numeric_limits<double>::infinity();
   s.hydraulic = std::numeric_limits<double>::infinity();  // no diffusion limit
   const std::vector<bool> with_particles = materials_with_particles(problem);
-  for (std::size_t i = 0; i < problem.materials.size(); ++i) {
+  // Varying parameters at their largest: the stiffest particle's wave.
+  const std::vector<Material> limiting = limiting_materials(problem);
+  for (std::size_t i = 0; i < limiting.size(); ++i) {
     if (!with_particles[i]) continue;
-    const MaterialConstants mc = material_constants(problem.materials[i], problem.gravity_constant);
+    const MaterialConstants mc = material_constants(limiting[i], problem.gravity_constant);
     const double c = std::sqrt(mc.constrained_modulus / mc.mixture_density);
     s.wave_speed = std::max(s.wave_speed, c);
     s.mechanical = std::min(s.mechanical, h / (c * std::sqrt(d)));

@@ -15,6 +15,8 @@
 #include <cstdint>
 #include <vector>
 
+#include "materials/varying.hpp"
+
 namespace hmpm {
 
 template <int Dim>
@@ -60,6 +62,11 @@ struct ParticleState {
   /// As many arrays as the most any model with particles declares.
   std::vector<std::vector<double>> internal;
 
+  /// Material parameters that vary from particle to particle (random
+  /// fields; materials/varying.hpp): arrays only for what some material
+  /// varies, none in a homogeneous run.
+  VaryingConstants varying;
+
   /// Staged jobs whose stages add or remove bodies: each particle's index
   /// in the job's numbering (the contract's), as particles come and go;
   /// empty otherwise.
@@ -91,6 +98,12 @@ struct ParticleState {
     f(states.darcy...);
     f(states.plastic_strain...);
     f(states.id...);
+    for (int k = 0; k < material_parameter_count; ++k)
+      f(states.varying.value[static_cast<std::size_t>(k)]...);
+    f(states.varying.elastic...);
+    f(states.varying.mohr_coulomb...);
+    f(states.varying.drucker_prager...);
+    f(states.varying.permeability_over_gamma...);
     const std::size_t internals = std::min({states.internal.size()...});
     for (std::size_t k = 0; k < internals; ++k) f(states.internal[k]...);
   }
@@ -156,6 +169,12 @@ struct ParticleState {
     per += sizeof(double) * internal.size();
     if (!plastic_strain.empty()) per += sizeof(double);
     if (!id.empty()) per += sizeof(std::int64_t);
+    for (const std::vector<double>& v : varying.value)
+      if (!v.empty()) per += sizeof(double);
+    if (!varying.elastic.empty()) per += sizeof(constitutive::Elastic);
+    if (!varying.mohr_coulomb.empty()) per += sizeof(constitutive::MohrCoulombConstants);
+    if (!varying.drucker_prager.empty()) per += sizeof(constitutive::DruckerPragerConstants);
+    if (!varying.permeability_over_gamma.empty()) per += sizeof(double);
     return static_cast<std::int64_t>(n * per);
   }
 };
