@@ -29,6 +29,7 @@ enum class Field : std::uint8_t {
   porosity,
   total_stress,
   plastic_strain,
+  excess_pore_pressure,
 };
 
 /// scalar: 1 component; vector: one per axis (dim); tensor: 6 in Voigt
@@ -43,7 +44,7 @@ struct FieldInfo {
 };
 
 /// Every field, in the order of the Field enumerators.
-inline constexpr std::array<FieldInfo, 10> field_table{{
+inline constexpr std::array<FieldInfo, 11> field_table{{
     {Field::position, "position", FieldKind::vector, "m"},
     {Field::displacement, "displacement", FieldKind::vector, "m"},
     {Field::velocity, "velocity", FieldKind::vector, "m/s"},
@@ -56,6 +57,11 @@ inline constexpr std::array<FieldInfo, 10> field_table{{
     // Accumulated equivalent plastic strain, sum of sqrt(2/3 deps_p : deps_p)
     // over the steps (zero for elastic materials).
     {Field::plastic_strain, "plastic_strain", FieldKind::scalar, "-"},
+    // The pore pressure minus the steady one at the particle's current
+    // position (output.consolidation's reference: its steady_pore_pressure,
+    // else the hydrostatic pressure under the geostatic water table, else
+    // 0); zero where the material has no pore water.
+    {Field::excess_pore_pressure, "excess_pore_pressure", FieldKind::scalar, "Pa"},
 }};
 inline constexpr int field_count = static_cast<int>(field_table.size());
 
