@@ -485,8 +485,6 @@ TEST(ParseJob, AStageGivesABodyANewMaterial) {
   EXPECT_NE(at(json{{"body", 1}, {"material", "clay"}}, "/stages/0/body_materials/0/material")
                 .find("unknown material 'clay'"),
             std::string::npos);
-  EXPECT_NE(at(json{{"body", 1}}, "/stages/0/body_materials/0").find("material"),
-            std::string::npos);
   EXPECT_NE(at(json{{"body", 7}, {"material", "a/b~c-mc"}}, "/stages/0/body_materials/0/body")
                 .find("does not exist"),
             std::string::npos);

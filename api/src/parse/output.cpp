@@ -95,6 +95,8 @@ void read_profiles(ParseContext& c, const json& j, const std::string& path) {
   OutputRequest& out = c.p.output;
   if (!r.object(j, path, profiles_allowed, profiles_required)) return;
   r.number_at(j, path, "interval", Range::positive(), out.profile_interval);
+  if (!j.contains("interval") && !j.contains("times"))
+    r.error(path + "/interval", "is required (or give the listed 'times')");
   if (j.contains("times") && r.array(j["times"], path + "/times", 1)) {
     const json& times = j["times"];
     if (times.size() > static_cast<std::size_t>(c.limits.max_series_rows)) {
