@@ -218,11 +218,15 @@ struct MemoryModel {
   static constexpr double setup_per_particle = 48;
 };
 
-/// Samples of the profiles (output.profiles): t = 0 and each interval.
+/// Samples of the profiles (output.profiles): t = 0, each interval and
+/// each listed time.
 double profile_rows(const Problem& p) {
   const OutputRequest& o = p.output;
-  if (o.profiles.empty() || !(o.profile_interval > 0)) return 0;
-  return std::floor(stage_problem(p, stage_count(p) - 1).time.end / o.profile_interval + 1e-9) + 1;
+  if (o.profiles.empty()) return 0;
+  const double listed = static_cast<double>(o.profile_times.size());
+  if (!(o.profile_interval > 0)) return 1 + listed;
+  return std::floor(stage_problem(p, stage_count(p) - 1).time.end / o.profile_interval + 1e-9) + 1 +
+         listed;
 }
 
 /// Values of one profile sample: every component of every field of every point.

@@ -24,6 +24,7 @@ std::uint64_t fingerprint(const Problem& problem, const std::string& key) {
   mix(problem.output.reactions_interval);
   mix(problem.output.profile_interval);
   mix(problem.output.profiles.size());
+  for (double tk : problem.output.profile_times) mix(tk);  // none: the fingerprint as before
   mix(problem.output.consolidation.interval);
   mix(problem.output.consolidation.from);
   mix(problem.stages.size());

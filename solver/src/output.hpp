@@ -18,6 +18,20 @@ double Simulation<Dim, Shape>::parameter_at(std::size_t p, MaterialParameter k) 
 }
 
 template <int Dim, class Shape>
+double Simulation<Dim, Shape>::excess_pore_pressure(std::size_t p) const {
+  if (particles_.pressure_out.empty() || !model_.constants[particles_.material[p]].saturated)
+    return 0.0;
+  const FieldOfPosition& steady = job_.output.consolidation.steady_pore_pressure;
+  double ps = 0.0;
+  if (steady) {
+    Vec3 x{0.0, 0.0, 0.0};
+    for (int a = 0; a < Dim; ++a) x[a] = particles_.x[p][a];
+    ps = steady(x);
+  }
+  return particles_.pressure_out[p] - ps;
+}
+
+template <int Dim, class Shape>
 void Simulation<Dim, Shape>::fill_snapshot(Snapshot& snap, const std::vector<Field>& fields) const {
   const std::size_t n = particles_.size();
   snap.dimension = Dim;
@@ -71,6 +85,10 @@ void Simulation<Dim, Shape>::fill_snapshot(Snapshot& snap, const std::vector<Fie
       case Field::plastic_strain:
         scalar(snap.plastic_strain, particles_.plastic_strain);
         break;
+      case Field::excess_pore_pressure:
+        snap.excess_pore_pressure.resize(n);
+        for (std::size_t p = 0; p < n; ++p) snap.excess_pore_pressure[p] = excess_pore_pressure(p);
+        break;
       case Field::effective_stress:
         voigt(snap.effective_stress, particles_.stress);
         break;
@@ -101,6 +119,11 @@ void Simulation<Dim, Shape>::fill_snapshot(Snapshot& snap, const std::vector<Fie
   snap.volume.assign(particles_.volume.begin(), particles_.volume.end());
   snap.mass.assign(particles_.mass.begin(), particles_.mass.end());
   snap.material.assign(particles_.material.begin(), particles_.material.end());
+  // Staged jobs whose stages move bodies keep each particle's job index;
+  // otherwise the run's order is the job's.
+  snap.id.resize(n);
+  for (std::size_t p = 0; p < n; ++p)
+    snap.id[p] = particles_.id.empty() ? static_cast<std::int64_t>(p) : particles_.id[p];
 }
 
 template <int Dim, class Shape>
@@ -141,6 +164,9 @@ void Simulation<Dim, Shape>::sample_series(Series& series, double t) const {
         case Field::plastic_strain:
           out.push_back(particles_.plastic_strain.empty() ? 0.0 : particles_.plastic_strain[p]);
           break;
+        case Field::excess_pore_pressure:
+          out.push_back(excess_pore_pressure(p));
+          break;
         case Field::effective_stress:
           for (int c = 0; c < 6; ++c) out.push_back(particles_.stress[p][c]);
           break;
@@ -167,19 +193,12 @@ template <int Dim, class Shape>
 void Simulation<Dim, Shape>::sample_consolidation(RunResult::Consolidation& c,
                                                   const std::vector<std::int64_t>& counted,
                                                   double t) const {
-  const FieldOfPosition& steady = job_.output.consolidation.steady_pore_pressure;
   double excess = 0.0, volume = 0.0;
   auto add = [&](std::size_t p) {
     const MaterialConstants& m = model_.constants[particles_.material[p]];
     if (!m.saturated || particles_.pressure_out.empty()) return;
     const double v0 = particles_.mass[p] / m.mixture_density;
-    double ps = 0.0;
-    if (steady) {
-      Vec3 x{0.0, 0.0, 0.0};
-      for (int a = 0; a < Dim; ++a) x[a] = particles_.x[p][a];
-      ps = steady(x);
-    }
-    excess += (particles_.pressure_out[p] - ps) * v0;
+    excess += excess_pore_pressure(p) * v0;
     volume += v0;
   };
   if (job_.output.consolidation.all) {

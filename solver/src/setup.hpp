@@ -75,6 +75,11 @@ void Simulation<Dim, Shape>::setup_materials() {
     model_.state_variables = std::max(
         model_.state_variables,
         state_variable_count(model_.constants[static_cast<std::size_t>(body.material)].model));
+  for (const Stage& s : job_.stages)  // materials a stage gives a body
+    for (const Stage::BodyMaterial& bm : s.body_materials)
+      model_.state_variables = std::max(
+          model_.state_variables,
+          state_variable_count(model_.constants[static_cast<std::size_t>(bm.material)].model));
   for (const ProblemIssue& w : problem_warnings(job_))
     warnings_.push_back(w.where.text().append(": ").append(w.message));
   for (int a = 0; a < Dim; ++a) model_.gravity[a] = model_.problem.gravity[a];
@@ -189,11 +194,15 @@ void Simulation<Dim, Shape>::setup_varying(const std::vector<BodyLayout>& layout
 template <int Dim, class Shape>
 void Simulation<Dim, Shape>::setup_stages() {
   job_particles_ = static_cast<std::int64_t>(particles_.size());
-  bool moves = false;
-  for (const Stage& s : job_.stages)
+  bool moves = false, switches = false;
+  for (const Stage& s : job_.stages) {
     moves = moves || !s.add_bodies.empty() || !s.remove_bodies.empty();
-  if (!moves) return;
+    switches = switches || !s.body_materials.empty();
+  }
+  if (!moves && !switches) return;
   interrupt_.stage("setting the stages' bodies aside");
+  // Each particle's body (a stage switching a body's material needs it
+  // too) by its job index.
   std::int64_t first = 0;
   for (const BodyLayout& l : body_layouts(model_.problem, LayoutDetail::counts)) {
     body_begin_.push_back(first);
@@ -202,6 +211,7 @@ void Simulation<Dim, Shape>::setup_stages() {
   particles_.id.resize(particles_.size());
   for (std::size_t p = 0; p < particles_.size(); ++p)
     particles_.id[p] = static_cast<std::int64_t>(p);
+  if (!moves) return;
   dormant_.resize(0, model_.fluid, std::is_same_v<Shape, shape::Gimp>, model_.state_variables,
                   model_.plastic);
   move_stage_particles(0);

@@ -245,9 +245,17 @@ class Simulation {
   void move_stage_particles(std::size_t k);
   /// Stage::reset_displacement: x0 = x, strain zero.
   void reset_displacement();
+  /// Stage::body_materials: the bodies' particles (in the run or not) take
+  /// their new material; plastic strain and internal state start from 0.
+  void switch_materials(const Stage& stage);
 
   // ------------------------------------------------------------ output (output.hpp)
   void fill_snapshot(Snapshot& snap, const std::vector<Field>& fields) const;
+  /// Particle p's pore pressure minus the steady one at its current position
+  /// (OutputRequest::consolidation's steady_pore_pressure; 0 without it), 0
+  /// where its material has no pore water: the output field
+  /// excess_pore_pressure and the sum of sample_consolidation.
+  double excess_pore_pressure(std::size_t p) const;
   void sample_series(Series& series, double t) const;
   /// Particle p's value of a material parameter: its own where it varies,
   /// else its material's.

@@ -2,7 +2,8 @@
 // next (internal; Problem::stages). The particle state carries over; the
 // Problem in force becomes the stage's (stage_problem), the particles of the
 // bodies it adds join the run and those of the bodies it removes leave it
-// (they wait, or stay, in dormant_), and everything compiled from the
+// (they wait, or stay, in dormant_), those of bodies it gives a new
+// material take it (switch_materials), and everything compiled from the
 // Problem or the particles (constraints, tractions, fluxes, reactions,
 // gravity) is compiled again. The time loop (time_loop.hpp) makes a fresh
 // scheme for each stage. Runs between steps only; allocates.
@@ -33,6 +34,22 @@ void Simulation<Dim, Shape>::move_stage_particles(std::size_t k) {
 }
 
 template <int Dim, class Shape>
+void Simulation<Dim, Shape>::switch_materials(const Stage& stage) {
+  auto body_of = [&](std::int64_t id) {
+    const auto after = std::upper_bound(body_begin_.begin(), body_begin_.end(), id);
+    return static_cast<int>(after - body_begin_.begin() - 1);
+  };
+  for (ParticleState<Dim>* state : {&particles_, &dormant_})
+    for (std::size_t p = 0; p < state->size(); ++p)
+      for (const Stage::BodyMaterial& bm : stage.body_materials)
+        if (bm.body == body_of(state->id[p])) {
+          state->material[p] = static_cast<std::uint16_t>(bm.material);
+          if (!state->plastic_strain.empty()) state->plastic_strain[p] = 0.0;
+          for (std::vector<double>& v : state->internal) v[p] = 0.0;
+        }
+}
+
+template <int Dim, class Shape>
 void Simulation<Dim, Shape>::reset_displacement() {
   for (std::size_t p = 0; p < particles_.size(); ++p) {
     particles_.x0[p] = particles_.x[p];
@@ -44,8 +61,11 @@ template <int Dim, class Shape>
 void Simulation<Dim, Shape>::enter_stage(std::size_t k) {
   // Stage by stage (a resumed run replays the moves of the stages it skips),
   // so the particles end in the order an uninterrupted run gives them.
-  if (!body_begin_.empty())
+  if (!slot_.empty())
     for (std::size_t j = stage_ + 1; j <= k; ++j) move_stage_particles(j);
+  // Stage by stage too: a resumed run then reads the particles' materials
+  // (those in the run) from its checkpoint.
+  for (std::size_t j = stage_ + 1; j <= k; ++j) switch_materials(job_.stages[j - 1]);
   // Stage by stage too: a resumed run reads the particle state after this.
   for (std::size_t j = stage_ + 1; j <= k; ++j)
     if (job_.stages[j - 1].reset_displacement) reset_displacement();

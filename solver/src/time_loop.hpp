@@ -101,15 +101,23 @@ RunResult Simulation<Dim, Shape>::run(const RunOptions& options) {
   };
   const bool want_series = !out.series_particles.empty() && !out.series_fields.empty();
   if (want_series) start_series(series, out.series_particles, out.series_fields);
-  // Profiles: sampled together at t = 0 and every profile_interval.
+  // Profiles: sampled together at t = 0, every profile_interval and at
+  // each of profile_times (the next one not sampled yet: next_listed).
   std::vector<Series>& profiles = result.profiles;
-  const bool want_profiles = !out.profiles.empty() && out.profile_interval > 0;
+  const bool want_profiles =
+      !out.profiles.empty() && (out.profile_interval > 0 || !out.profile_times.empty());
   if (want_profiles) {
     profiles.resize(out.profiles.size());
     for (std::size_t l = 0; l < profiles.size(); ++l)
       start_series(profiles[l], out.profiles[l].particles, out.profiles[l].fields);
   }
-  double next_profile = out.profile_interval;
+  double next_profile =
+      out.profile_interval > 0 ? out.profile_interval : std::numeric_limits<double>::infinity();
+  std::size_t next_listed = 0;
+  auto listed_time = [&]() {
+    return next_listed < out.profile_times.size() ? out.profile_times[next_listed]
+                                                  : std::numeric_limits<double>::infinity();
+  };
   // Consolidation: the excess of the counted particles (job indices; none
   // listed: every particle in the run) at `from`, then every interval after it.
   const ConsolidationRequest& cr = out.consolidation;
@@ -194,6 +202,12 @@ RunResult Simulation<Dim, Shape>::run(const RunOptions& options) {
       r.array(s.time, -1, "profile times");
       for (std::vector<double>& v : s.values) r.array(v, -1, "profile values");
     }
+    // The listed times sampled already: those up to t, and those within the
+    // tolerance of the step that ended at t (1e-9 of its length, at most
+    // 1e-9 t) when it took a sample.
+    const bool sampled_at_t =
+        !profiles.empty() && !profiles[0].time.empty() && profiles[0].time.back() == t;
+    while (listed_time() <= (sampled_at_t ? t + 1e-9 * t : t)) ++next_listed;
     next_consolidation = r.pod<double>();
     r.array(consolidation.time, -1, "consolidation times");
     r.array(consolidation.excess, static_cast<std::int64_t>(consolidation.time.size()),
@@ -228,6 +242,7 @@ RunResult Simulation<Dim, Shape>::run(const RunOptions& options) {
   } else {
     if (want_series) sample_series(series, 0.0);
     for (Series& s : profiles) sample_series(s, 0.0);
+    while (listed_time() <= 0.0) ++next_listed;  // t = 0 is sampled anyway
     if (want_consolidation && !(cr.from > 0)) sample_consolidation(consolidation, counted, 0.0);
     if (want_snapshots) take_snapshot(0.0);
   }
@@ -409,9 +424,10 @@ RunResult Simulation<Dim, Shape>::run(const RunOptions& options) {
                                                                      : 0.0);
         while (next_reaction <= t + eps_t) next_reaction += out.reactions_interval;
       }
-      if (want_profiles && t >= next_profile - eps_t) {
+      if (want_profiles && t >= std::min(next_profile, listed_time()) - eps_t) {
         for (Series& s : profiles) sample_series(s, t);
         while (next_profile <= t + eps_t) next_profile += out.profile_interval;
+        while (listed_time() <= t + eps_t) ++next_listed;
       }
       if (want_consolidation && t >= next_consolidation - eps_t) {
         sample_consolidation(consolidation, counted, t);

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -266,6 +267,229 @@ TEST(Consolidation, NoSteadyPressureUnderGravityWarnsWithTheFormula) {
   // Following it silences it.
   spec["output"]["consolidation"]["steady_pore_pressure"] = "9810*(5 - x)";
   EXPECT_EQ(issue_at(spec, "/output/consolidation", true), "");
+}
+
+// The output field excess_pore_pressure: the pore pressure minus the
+// steady one at the particle's current position, with output.consolidation's
+// reference (here its default, the hydrostatic pressure under the geostatic
+// water table), asked for without output.consolidation. In the column
+// loaded suddenly it is Terzaghi's excess, while the pore pressure itself
+// carries the hydrostatic part (up to gamma_w H = 49 kPa against q = 50 kPa).
+// Tolerance: 2 % of q (the interior error of the excess is below 1 % of q
+// at 40 cells, see SuddenLoadUnderGravityIsTerzaghisDegreeFromHydrostatic,
+// plus the finite-strain shift gamma_w s / q = 0.07 %). The definition
+// itself, p - gamma_w (H - x) at the current x, holds to round-off.
+TEST(ExcessPorePressure, IsTerzaghisExcessInAColumnWithAHydrostaticPart) {
+  const Column c;
+  json spec = column_spec(c);
+  spec["output"].erase("consolidation");
+  spec["time"]["end"] = c.time_of(0.3);
+  spec["output"]["series"] = {
+      {"particles",
+       json::array({json{{"near", one(1.0)}}, json{{"near", one(2.5)}}, json{{"near", one(4.0)}}})},
+      {"fields", {"position", "pore_pressure", "excess_pore_pressure"}},
+      {"interval", c.time_of(0.1)}};
+  spec["output"]["snapshots"] = {{"interval", c.time_of(0.1)},
+                                 {"fields", {"pore_pressure", "excess_pore_pressure"}}};
+  const ParseResult r = parse_job(spec.dump());
+  for (const SpecError& e : r.errors) ADD_FAILURE() << e.path << ": " << e.message;
+  ASSERT_TRUE(r.job.has_value());
+  for (const SpecError& w : r.job->warnings) ADD_FAILURE() << w.path << ": " << w.message;
+  const double gamma_w = 1000.0 * 9.81;
+  double worst_definition = 0.0;
+  std::size_t snapshots = 0;
+  RunOptions options;
+  options.on_snapshot = [&](const Snapshot& s) {
+    ++snapshots;
+    ASSERT_EQ(s.excess_pore_pressure.size(), static_cast<std::size_t>(s.particles));
+    for (std::size_t p = 0; p < s.excess_pore_pressure.size(); ++p)
+      worst_definition = std::max(
+          worst_definition, std::abs(s.excess_pore_pressure[p] -
+                                     (s.pore_pressure[p] - gamma_w * (c.H - s.position[3 * p]))));
+  };
+  const RunResult run = hmpm::run(r.job->problem, options);
+  ASSERT_EQ(run.status, RunStatus::successful) << run.message;
+  EXPECT_EQ(snapshots, 4u);  // t = 0 and T_v = 0.1, 0.2, 0.3
+  EXPECT_LT(worst_definition, 1e-9 * c.q);
+  const Series& s = run.series;
+  ASSERT_EQ(s.time.size(), 4u);
+  ASSERT_EQ(s.fields.size(), 3u);
+  double worst = 0.0, hydrostatic = 0.0;
+  for (std::size_t k = 1; k < s.time.size(); ++k) {
+    const double tv = s.time[k] / c.time_of(1.0);
+    for (std::size_t i = 0; i < s.particles.size(); ++i) {
+      const double x = s.values[0][k * 3 + i], p = s.values[1][k * 3 + i];
+      const double excess = s.values[2][k * 3 + i];
+      EXPECT_NEAR(excess, p - gamma_w * (c.H - x), 1e-9 * c.q);
+      const double exact = closed_form::terzaghi_pressure(s.initial_positions[i][0], tv, c.H, c.q);
+      worst = std::max(worst, std::abs(excess - exact));
+      hydrostatic = std::max(hydrostatic, p - excess);
+    }
+  }
+  std::printf("excess pore pressure, 40 cells: max |u - u_Terzaghi| = %.4g q\n", worst / c.q);
+  EXPECT_LT(worst, 0.02 * c.q);
+  EXPECT_GT(hydrostatic, 0.5 * gamma_w * c.H);  // the pressure's hydrostatic part is not small
+}
+
+// A column at rest under its hydrostatic pressure: the excess is zero to
+// round-off everywhere while the pore pressure is not. At t = 0 (the
+// geostatic state) and after one long quasi-static step (T_v = 1): short
+// steps on coarse cells leave the quasi-static scheme's known offset from
+// hydrostatic of order h^3/dt (docs/schemes.md), which this field shows as
+// it is (measured 889 Pa at the base with 10 cells and steps of T_v = 1e-4).
+TEST(ExcessPorePressure, IsZeroInAHydrostaticColumnAtRest) {
+  Column c;
+  c.cells = 10;
+  json spec = column_spec(c);
+  spec.erase("tractions");
+  spec["output"].erase("consolidation");
+  spec["time"] = {{"end", c.time_of(1.0)}, {"scheme", "quasi_static"}, {"dt", c.time_of(1.0)}};
+  spec["output"]["profiles"] = {
+      {"interval", c.time_of(1.0)},
+      {"lines", json::array({json{{"from", one(0.0)},
+                                  {"to", one(c.H)},
+                                  {"points", 11},
+                                  {"fields", {"pore_pressure", "excess_pore_pressure"}}}})}};
+  const ParseResult r = parse_job(spec.dump());
+  ASSERT_TRUE(r.job.has_value());
+  const RunResult run = hmpm::run(r.job->problem);
+  ASSERT_EQ(run.status, RunStatus::successful) << run.message;
+  ASSERT_EQ(run.profiles.size(), 1u);
+  const Series& s = run.profiles[0];
+  ASSERT_EQ(s.time.size(), 2u);
+  // Row 0: the geostatic state, zero to round-off. Row 1: after the long
+  // step, the scheme's offset from hydrostatic (measured 2.7 Pa, 5.6e-5 of
+  // the largest pressure), bounded at 1e-4.
+  const std::size_t np = s.particles.size();
+  double largest_p = 0.0, excess0 = 0.0, excess1 = 0.0;
+  for (double p : s.values[0]) largest_p = std::max(largest_p, std::abs(p));
+  for (std::size_t i = 0; i < np; ++i) {
+    excess0 = std::max(excess0, std::abs(s.values[1][i]));
+    excess1 = std::max(excess1, std::abs(s.values[1][np + i]));
+  }
+  EXPECT_GT(largest_p, 0.8 * 1000.0 * 9.81 * c.H);
+  EXPECT_LT(excess0, 1e-9 * largest_p);
+  EXPECT_LT(excess1, 1e-4 * largest_p);
+}
+
+// Listed by name without a reference under gravity: the warning of
+// output.consolidation, at the field's path, with the formula to write.
+TEST(ExcessPorePressure, NoReferenceUnderGravityWarnsAtTheFieldsPath) {
+  const Column c;
+  json spec = column_spec(c);
+  spec.erase("initial_state");
+  spec["output"].erase("consolidation");
+  spec["output"]["series"] = {{"particles", {0}},
+                              {"fields", {"pore_pressure", "excess_pore_pressure"}}};
+  const std::string w = issue_at(spec, "/output/series/fields/1", true);
+  EXPECT_NE(w.find("9810*(WT - x)"), std::string::npos) << w;
+  EXPECT_NE(w.find("water_table"), std::string::npos) << w;
+}
+
+// Profiles at listed times (isochrones): the quasi-static scheme's growing
+// steps land on each listed time exactly (it shortens the step before),
+// and each isochrone of the excess is Terzaghi's at its time (2 % of q, as
+// above). T_v = 0.013, 0.07, 0.41: not multiples of anything the steps or
+// the other outputs do.
+TEST(ProfileTimes, QuasiStaticStepsLandOnTheListedTimes) {
+  const Column c;
+  json spec = column_spec(c);
+  spec["output"].erase("consolidation");
+  spec["time"]["end"] = c.time_of(0.5);
+  const std::vector<double> tv = {0.013, 0.07, 0.41};
+  json times = json::array();
+  for (double v : tv) times.push_back(c.time_of(v));
+  spec["output"]["profiles"] = {
+      {"times", times},
+      {"lines", json::array({json{{"from", one(0.0)},
+                                  {"to", one(c.H)},
+                                  {"points", 21},
+                                  {"fields", {"excess_pore_pressure"}}}})}};
+  const ParseResult r = parse_job(spec.dump());
+  for (const SpecError& e : r.errors) ADD_FAILURE() << e.path << ": " << e.message;
+  ASSERT_TRUE(r.job.has_value());
+  EXPECT_EQ(r.job->problem.output.profile_times.size(), 3u);
+  const RunResult run = hmpm::run(r.job->problem);
+  ASSERT_EQ(run.status, RunStatus::successful) << run.message;
+  ASSERT_EQ(run.profiles.size(), 1u);
+  const Series& s = run.profiles[0];
+  ASSERT_EQ(s.time.size(), 4u);  // t = 0 and the three listed
+  EXPECT_EQ(s.time[0], 0.0);
+  const std::size_t np = s.particles.size();
+  double worst = 0.0;
+  for (std::size_t k = 1; k < s.time.size(); ++k) {
+    EXPECT_NEAR(s.time[k], times[k - 1].get<double>(), 1e-12 * s.time[k]);
+    for (std::size_t i = 0; i < np; ++i) {
+      const double exact =
+          closed_form::terzaghi_pressure(s.initial_positions[i][0], tv[k - 1], c.H, c.q);
+      worst = std::max(worst, std::abs(s.values[0][k * np + i] - exact));
+    }
+  }
+  std::printf("isochrones at listed times: max |u - u_Terzaghi| = %.4g q\n", worst / c.q);
+  EXPECT_LT(worst, 0.02 * c.q);
+}
+
+// Fixed steps cannot land on a listed time: the sample is the end of the
+// first step that reaches it, and profiles say that step's time (at most
+// one step late), never the listed one. With an interval as well, both
+// schedules are sampled, each once.
+TEST(ProfileTimes, FixedStepsSampleTheFirstStepReachingEachTimeAndSayWhen) {
+  Column c;
+  c.cells = 10;
+  json spec = column_spec(c);
+  spec["output"].erase("consolidation");
+  const double end = c.time_of(0.1), dt = end / 40;
+  spec["time"] = {{"end", end}, {"scheme", "quasi_static"}, {"dt", dt}};
+  const std::vector<double> listed = {0.33 * dt, 7.5 * dt, 20 * dt};
+  spec["output"]["profiles"] = {
+      {"times", listed},
+      {"interval", 10 * dt},
+      {"lines",
+       json::array({json{
+           {"from", one(0.0)}, {"to", one(c.H)}, {"points", 3}, {"fields", {"pore_pressure"}}}})}};
+  const ParseResult r = parse_job(spec.dump());
+  for (const SpecError& e : r.errors) ADD_FAILURE() << e.path << ": " << e.message;
+  ASSERT_TRUE(r.job.has_value());
+  const RunResult run = hmpm::run(r.job->problem);
+  ASSERT_EQ(run.status, RunStatus::successful) << run.message;
+  ASSERT_EQ(run.profiles.size(), 1u);
+  const std::vector<double>& t = run.profiles[0].time;
+  // 0; dt (for 0.33 dt); 8 dt (for 7.5 dt); 10, 20 (listed and interval: once), 30, 40 dt.
+  const std::vector<double> expected = {0, 1, 8, 10, 20, 30, 40};
+  ASSERT_EQ(t.size(), expected.size());
+  for (std::size_t k = 0; k < t.size(); ++k) EXPECT_NEAR(t[k], expected[k] * dt, 1e-9 * dt) << k;
+}
+
+TEST(ProfileTimes, MistakesAreReportedAtTheirPaths) {
+  const Column c;
+  json spec = column_spec(c);
+  const json line =
+      json{{"from", one(0.0)}, {"to", one(c.H)}, {"points", 3}, {"fields", {"pore_pressure"}}};
+  const double end = spec["time"]["end"].get<double>();
+  auto with_times = [&](const json& times) {
+    json s = spec;
+    s["output"]["profiles"] = {{"times", times}, {"lines", json::array({line})}};
+    return s;
+  };
+  EXPECT_EQ(issue_at(with_times(json::array({0.0, end / 2, end})), "/output/profiles"), "");
+  EXPECT_NE(issue_at(with_times(json::array({end / 2, end / 4})), "/output/profiles/times/1")
+                .find("increasing order"),
+            std::string::npos);
+  EXPECT_NE(issue_at(with_times(json::array({end / 2, end / 2})), "/output/profiles/times/1")
+                .find("increasing order"),
+            std::string::npos);
+  EXPECT_NE(issue_at(with_times(json::array({-1.0})), "/output/profiles/times/0").find("[0, "),
+            std::string::npos);
+  EXPECT_NE(issue_at(with_times(json::array({end / 2, 2 * end})), "/output/profiles/times/1")
+                .find("inside the run"),
+            std::string::npos);
+  EXPECT_NE(issue_at(with_times(json::array()), "/output/profiles/times"), "");
+  EXPECT_NE(issue_at(with_times("soon"), "/output/profiles/times"), "");
+  EXPECT_NE(issue_at(with_times(json::array({"soon"})), "/output/profiles/times/0"), "");
+  // Neither an interval nor times: said at the interval's path.
+  json none = spec;
+  none["output"]["profiles"] = {{"lines", json::array({line})}};
+  EXPECT_NE(issue_at(none, "/output/profiles/interval").find("times"), std::string::npos);
 }
 
 }  // namespace

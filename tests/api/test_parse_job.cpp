@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "hmpm/api/job.hpp"
+#include "spec_support.hpp"
 #include "test_support.hpp"
 
 namespace hmpm::api {
@@ -452,6 +453,79 @@ TEST(ParseJob, FrictionNeedsExactlyOneNormalComponent) {
                   "/boundaries/0/friction", ">= 0"));
   EXPECT_TRUE(has(errors_of(R"({"nodes": "all", "velocity": [null, 0], "friction": "sticky"})"),
                   "/boundaries/0/friction", "\"rough\""));
+}
+
+// stages[i].body_materials: a body's new material by name, read into the
+// stage (materials are numbered in name order); mistakes at their paths.
+TEST(ParseJob, AStageGivesABodyANewMaterial) {
+  json spec = json::parse(read_text(source_path("tests/api/data/valid-2d.json")));
+  spec["materials"]["a/b~c-mc"] = spec["materials"]["a/b~c"];
+  spec["materials"]["a/b~c-mc"]["model"] = "mohr_coulomb";
+  spec["materials"]["a/b~c-mc"]["friction_angle"] = 30;
+  spec["materials"]["a/b~c-mc"]["cohesion"] = 1000;
+  spec["materials"]["a/b~c-mc"]["dilatancy_angle"] = 0;
+  const double end = spec["time"]["end"].get<double>();
+  spec["stages"] = json::array(
+      {json{{"end", 2 * end},
+            {"body_materials", json::array({json{{"body", 1}, {"material", "a/b~c-mc"}}})}}});
+  const ParsedJob job = parse_valid(spec.dump());
+  ASSERT_EQ(job.problem.stages.size(), 1u);
+  ASSERT_EQ(job.problem.stages[0].body_materials.size(), 1u);
+  EXPECT_EQ(job.problem.stages[0].body_materials[0].body, 1);
+  EXPECT_EQ(
+      job.problem
+          .materials[static_cast<std::size_t>(job.problem.stages[0].body_materials[0].material)]
+          .name,
+      "a/b~c-mc");
+  auto at = [&](const json& entry, const std::string& path) {
+    json s = spec;
+    s["stages"][0]["body_materials"] = json::array({entry});
+    return testing::issue_at(s, path);
+  };
+  EXPECT_NE(at(json{{"body", 1}, {"material", "clay"}}, "/stages/0/body_materials/0/material")
+                .find("unknown material 'clay'"),
+            std::string::npos);
+  EXPECT_NE(at(json{{"body", 7}, {"material", "a/b~c-mc"}}, "/stages/0/body_materials/0/body")
+                .find("does not exist"),
+            std::string::npos);
+  EXPECT_NE(at(json{{"body", 1}, {"material", "sand"}}, "/stages/0/body_materials/0/material")
+                .find("same density"),
+            std::string::npos);
+}
+
+// The quasi-static scheme has no Coulomb slip: a friction wall (finite or
+// rough) is refused at its path with the reason and the remedies, instead
+// of running as a frictionless wall; in a stage that switches to the
+// scheme with the wall in force from before, at the stage.
+TEST(ParseJob, FrictionWallsAreRefusedByTheQuasiStaticScheme) {
+  json spec = json::parse(read_text(source_path("tests/api/data/valid-2d.json")));
+  const json wall = json::parse(
+      R"({"nodes": {"box": {"min": [0, 0], "max": [1, 0]}}, "velocity": [null, 0], "friction": 0.5})");
+  spec["boundaries"].push_back(wall);
+  const std::string at =
+      "/boundaries/" + std::to_string(spec["boundaries"].size() - 1) + "/friction";
+  EXPECT_EQ(testing::issue_at(spec, at), "");  // the explicit scheme has Coulomb slip
+  json qs = spec;
+  qs["time"]["scheme"] = "quasi_static";
+  for (const json& friction : {json(0.5), json("rough")}) {
+    qs["boundaries"].back()["friction"] = friction;
+    const std::string m = testing::issue_at(qs, at);
+    EXPECT_NE(m.find("not supported by the quasi-static scheme"), std::string::npos) << m;
+    EXPECT_NE(m.find("frictionless"), std::string::npos) << m;
+    EXPECT_NE(m.find("\"velocity\": [0, 0]"), std::string::npos) << m;
+    EXPECT_NE(m.find("explicit or semi_implicit"), std::string::npos) << m;
+  }
+  // A stage switching to the quasi-static scheme with the wall in force.
+  json staged = spec;
+  const double end = spec["time"]["end"].get<double>();
+  staged["stages"] = json::array({json{
+      {"name", "static"}, {"end", 2 * end}, {"time", {{"scheme", "quasi_static"}, {"dt", end}}}}});
+  const ParseResult r = parse_job(staged.dump());
+  bool found = false;
+  for (const SpecError& e : r.errors)
+    found = found || (e.path == "/stages/0" && e.message.find(at.substr(1)) != std::string::npos &&
+                      e.message.find("quasi-static") != std::string::npos);
+  EXPECT_TRUE(found);
 }
 
 }  // namespace

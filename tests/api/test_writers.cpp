@@ -265,6 +265,7 @@ TEST(Writers, SnapshotsCarryComponentAndMaterialNamesForVtk) {
   Snapshot s = synthetic_snapshot(1, 5);
   s.fields.push_back(Field::plastic_strain);
   for (int i = 0; i < 5; ++i) s.plastic_strain.push_back(0.125 * i);
+  s.id = {7, 3, 12, 0, 40};  // the job's numbering, not the run's order
   write_snapshot_vtu(dir.path() / "snapshot_0001.vtu", s, {"clay", "sand & \"fill\""});
   const std::string script = (dir.path() / "probe.py").string();
   std::ofstream(script) << "import sys, vtk\n"
@@ -279,7 +280,10 @@ TEST(Writers, SnapshotsCarryComponentAndMaterialNamesForVtk) {
                            "print(sorted((fd.GetArrayName(i), fd.GetArray(i).GetValue(0)) "
                            "for i in range(fd.GetNumberOfArrays())))\n"
                            "e = pd.GetArray('plastic_strain')\n"
-                           "print([e.GetValue(i) for i in range(e.GetNumberOfTuples())])\n";
+                           "print([e.GetValue(i) for i in range(e.GetNumberOfTuples())])\n"
+                           "i = pd.GetArray('particle_id')\n"
+                           "print(i.GetDataTypeAsString(), "
+                           "[i.GetValue(k) for k in range(i.GetNumberOfTuples())])\n";
   const auto v = testing::run_command(
       "/usr/bin/python3 '" + script + "' '" + (dir.path() / "snapshot_0001.vtu").string() + "'",
       dir.path());
@@ -288,7 +292,8 @@ TEST(Writers, SnapshotsCarryComponentAndMaterialNamesForVtk) {
             "velocity ['x', 'y', 'z']\n"
             "effective_stress ['xx', 'yy', 'zz', 'xy', 'yz', 'zx']\n"
             "[('TimeValue', 0.25), ('material clay', 0), ('material sand & \"fill\"', 1)]\n"
-            "[0.0, 0.125, 0.25, 0.375, 0.5]\n")
+            "[0.0, 0.125, 0.25, 0.375, 0.5]\n"
+            "long long [7, 3, 12, 0, 40]\n")
       << v.err;
 }
 

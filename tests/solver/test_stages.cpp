@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -152,6 +153,54 @@ TEST(Stages, ExcavationThenSwellingIsTheUnloadingClosedForm) {
   EXPECT_NE(ef.result.message.find("2 stages"), std::string::npos) << ef.result.message;
 }
 
+// Snapshots name each point by its particle's index in the job's
+// numbering (that of the series), also after a stage removes a body listed
+// before the others: here the block (body 0, the job's first particles) is
+// excavated, so the layer's particles are renumbered in the run; every
+// point of the last snapshot must sit exactly where the series puts the
+// particle its id names, and the block's ids must be gone.
+TEST(Stages, SnapshotIdsAreTheJobsNumberingAfterAnExcavation) {
+  const Excavation c;
+  const double stage_one = c.time_of(0.05), end = stage_one + c.time_of(0.01);
+  hmpm::Problem p = excavation(c, stage_one, c.time_of(0.01));
+  std::swap(p.bodies[0], p.bodies[1]);  // the block first: its particles are numbered first
+  p.stages[0].remove_bodies = {0};
+  const std::int64_t block = static_cast<std::int64_t>(c.a * c.cells_per_m) * c.ppc;
+  const std::int64_t all = static_cast<std::int64_t>(c.cells()) * c.ppc;
+  p.output.series_particles.clear();
+  for (std::int64_t i = 0; i < all; ++i) p.output.series_particles.push_back(i);
+  p.output.series_fields = {hmpm::Field::position};
+  p.output.series_interval = end / 2;
+  p.output.snapshot_interval = end / 2;
+  p.output.snapshot_fields = {hmpm::Field::position};
+  std::vector<hmpm::Snapshot> snaps;
+  hmpm::RunOptions options;
+  options.on_snapshot = [&](const hmpm::Snapshot& s) { snaps.push_back(s); };
+  const hmpm::RunResult r = hmpm::run(p, options);
+  ASSERT_EQ(r.status, hmpm::RunStatus::successful) << r.message;
+  ASSERT_EQ(snaps.size(), 3u);
+  // Before the excavation: every particle, in the job's order.
+  ASSERT_EQ(snaps.front().id.size(), static_cast<std::size_t>(all));
+  for (std::int64_t i = 0; i < all; ++i)
+    EXPECT_EQ(snaps.front().id[static_cast<std::size_t>(i)], i);
+  // After it: the layer's particles only, each where the series says.
+  const hmpm::Snapshot& last = snaps.back();
+  const hmpm::Series& s = r.series;
+  ASSERT_EQ(last.time, s.time.back());
+  ASSERT_EQ(last.id.size(), static_cast<std::size_t>(all - block));
+  const std::size_t row = (s.time.size() - 1) * static_cast<std::size_t>(all);
+  std::vector<bool> seen(static_cast<std::size_t>(all), false);
+  for (std::size_t k = 0; k < last.id.size(); ++k) {
+    const std::int64_t id = last.id[k];
+    ASSERT_GE(id, block) << "an excavated particle in the snapshot";
+    ASSERT_LT(id, all);
+    EXPECT_FALSE(seen[static_cast<std::size_t>(id)]);
+    seen[static_cast<std::size_t>(id)] = true;
+    EXPECT_EQ(last.position[3 * k], s.values[0][row + static_cast<std::size_t>(id)]) << id;
+    EXPECT_NEAR(last.position[3 * k], s.initial_positions[static_cast<std::size_t>(id)][0], 0.01);
+  }
+}
+
 TEST(Stages, ChecksSayWhereEachStageIsWrong) {
   const Excavation c;
   hmpm::Problem p = excavation(c, 1.0, 10.0);
@@ -278,27 +327,35 @@ TEST(GravityLoading, LevelLayersGiveTheGeostaticClosedForm) {
 // quasi-static step, then 0.2 s of the explicit scheme with the
 // displacements reset: the explicit run must find it at rest. Measured
 // motion in the explicit stage against the gravity-loading settlement.
+// A dry elastic slope with a toe (a polygon, 3 m high over 4 m), fixed
+// base, rollers on the sides, loaded by gravity in one quasi-static step
+// of 1 s: `per_m` cells per metre.
+hmpm::Problem gravity_loaded_slope(int per_m) {
+  hmpm::Problem p;
+  p.dimension = 2;
+  p.grid.max = {12.0, 6.0, 0};
+  p.grid.cells = {12 * per_m, 6 * per_m, 1};
+  p.materials.push_back(problems::elastic(2000, 2e7, 0.3));
+  hmpm::Body slope;
+  slope.polygon = hmpm::Polygon{{{0, 0}, {12, 0}, {12, 2}, {8, 2}, {4, 5}, {0, 5}}};
+  slope.particles_per_cell = 2;
+  p.bodies.push_back(slope);
+  p.gravity = {0, -9.81, 0};
+  hmpm::Boundary base = problems::fixed_velocity(problems::plane(p, 1, 0.0), 1);
+  base.velocity[0] = problems::constant(0.0);
+  p.boundaries.push_back(base);
+  p.boundaries.push_back(problems::fixed_velocity(problems::plane(p, 0, 0.0), 0));
+  p.boundaries.push_back(problems::fixed_velocity(problems::plane(p, 0, 12.0), 0));
+  p.time.scheme = hmpm::Scheme::quasi_static;
+  p.time.end = 1.0;
+  p.time.dt = 1.0;
+  p.first_stage_name = "gravity loading";
+  return p;
+}
+
 TEST(GravityLoading, AShapedSlopeIsLeftAtRest) {
   for (int per_m : {2, 4}) {
-    hmpm::Problem p;
-    p.dimension = 2;
-    p.grid.max = {12.0, 6.0, 0};
-    p.grid.cells = {12 * per_m, 6 * per_m, 1};
-    p.materials.push_back(problems::elastic(2000, 2e7, 0.3));
-    hmpm::Body slope;
-    slope.polygon = hmpm::Polygon{{{0, 0}, {12, 0}, {12, 2}, {8, 2}, {4, 5}, {0, 5}}};
-    slope.particles_per_cell = 2;
-    p.bodies.push_back(slope);
-    p.gravity = {0, -9.81, 0};
-    hmpm::Boundary base = problems::fixed_velocity(problems::plane(p, 1, 0.0), 1);
-    base.velocity[0] = problems::constant(0.0);
-    p.boundaries.push_back(base);
-    p.boundaries.push_back(problems::fixed_velocity(problems::plane(p, 0, 0.0), 0));
-    p.boundaries.push_back(problems::fixed_velocity(problems::plane(p, 0, 12.0), 0));
-    p.time.scheme = hmpm::Scheme::quasi_static;
-    p.time.end = 1.0;
-    p.time.dt = 1.0;
-    p.first_stage_name = "gravity loading";
+    hmpm::Problem p = gravity_loaded_slope(per_m);
     hmpm::Stage rest;
     rest.name = "at rest";
     rest.end = 1.2;
@@ -339,6 +396,145 @@ TEST(GravityLoading, AShapedSlopeIsLeftAtRest) {
     // of 2e-3, a force mismatch of that order, twice it dynamically).
     EXPECT_LT(moved, 0.02 * settlement);
   }
+}
+
+// A stage may give a body a new material: the usual way to load a
+// Mohr-Coulomb slope, elastic gravity loading (one quasi-static step, the
+// K0 stress of level ground away from the slope), then Mohr-Coulomb with
+// the stress kept. Under the crest, far from the slope face and 1-4 m
+// deep, the elastic stage's horizontal stress is K0 = nu/(1-nu) of the
+// vertical one (within 5 %: the level-ground error of a quarter cell of
+// weight, see LevelLayersGiveTheGeostaticClosedForm, and the slope's
+// influence). With a Mohr-Coulomb material the ground can carry (its
+// stress inside the yield surface everywhere) the switch must change
+// nothing: the stress after a Mohr-Coulomb step is the elastic stage's to
+// 1e-6 of the largest stress and no plastic strain appears. With a weak
+// one (c = 5 kPa, phi = 30 degrees) the step converges and yields; a
+// further switch back to the strong material starts the plastic strain
+// from 0 again.
+struct SlopeSwitch {
+  hmpm::RunResult run;
+  std::vector<double> ratio;  // sigma_xx / sigma_yy under the crest after the elastic stage
+};
+
+SlopeSwitch slope_with_switch(double cohesion, double phi, bool switch_back) {
+  hmpm::Problem p = gravity_loaded_slope(2);
+  // Material 0: elastic, for the gravity loading.
+  hmpm::Material mc = p.materials[0];
+  mc.name = "mc";
+  mc.plasticity = hmpm::MohrCoulomb{phi, 0.0, cohesion, 0.0};
+  p.materials.push_back(mc);  // 1
+  hmpm::Material strong = mc;
+  strong.name = "strong";
+  strong.plasticity = hmpm::MohrCoulomb{40.0, 0.0, 1e6, 1e6};
+  p.materials.push_back(strong);  // 2
+  p.first_stage_name = "elastic gravity loading";
+  hmpm::Stage plastic;
+  plastic.name = "mohr-coulomb";
+  plastic.end = 2.0;
+  plastic.body_materials = {{0, 1}};
+  plastic.reset_displacement = true;
+  p.stages.push_back(plastic);
+  if (switch_back) {
+    hmpm::Stage back;
+    back.name = "strong";
+    back.end = 3.0;
+    back.body_materials = {{0, 2}};
+    p.stages.push_back(back);
+  }
+  const auto n = hmpm::count_particles(p);
+  for (std::int64_t i = 0; i < n; ++i) p.output.series_particles.push_back(i);
+  p.output.series_fields = {hmpm::Field::effective_stress, hmpm::Field::plastic_strain};
+  p.output.series_interval = 1.0;
+  SlopeSwitch out;
+  out.run = hmpm::run(p);
+  const hmpm::Series& s = out.run.series;
+  for (std::size_t i = 0; i < s.particles.size() && s.time.size() > 1; ++i) {
+    const hmpm::Vec3& x = s.initial_positions[i];
+    if (x[0] > 2.0 || x[1] < 1.0 || x[1] > 4.0) continue;
+    const double* sig = &s.values[0][(1 * s.particles.size() + i) * 6];
+    out.ratio.push_back(sig[0] / sig[1]);
+  }
+  return out;
+}
+
+// DISABLED: its expectations are wrong, not yet the code (measured at
+// fb9d8a6): the K0 ratio over x <= 2 m, 1-4 m deep is off by up to 28 %
+// (the region is too near the slope or the surface), the stress changes by
+// 0.54 % of the largest at the first Mohr-Coulomb step (the second
+// quasi-static step re-solves equilibrium in the moved configuration, as
+// the explicit stage of AShapedSlopeIsLeftAtRest does), and c = 5 kPa,
+// phi = 30 does not yield. To be re-designed (issue 44).
+TEST(Stages, DISABLED_AStageSwitchesAGravityLoadedSlopeFromElasticToMohrCoulomb) {
+  const double k0 = 0.3 / 0.7;
+  const SlopeSwitch strong = slope_with_switch(1e6, 40.0, false);
+  ASSERT_EQ(strong.run.status, hmpm::RunStatus::successful) << strong.run.message;
+  const hmpm::Series& s = strong.run.series;
+  const std::size_t np = s.particles.size();
+  ASSERT_EQ(s.time.size(), 3u);  // 0, the end of the elastic stage, the end of the MC one
+  ASSERT_FALSE(strong.ratio.empty());
+  double worst_k0 = 0.0;
+  for (double r : strong.ratio) worst_k0 = std::max(worst_k0, std::abs(r - k0) / k0);
+  double largest = 0.0, change = 0.0, plastic = 0.0;
+  for (std::size_t i = 0; i < np; ++i)
+    for (int c = 0; c < 6; ++c) {
+      const double a = s.values[0][(1 * np + i) * 6 + c], b = s.values[0][(2 * np + i) * 6 + c];
+      largest = std::max(largest, std::abs(a));
+      change = std::max(change, std::abs(b - a));
+    }
+  for (std::size_t i = 0; i < np; ++i) plastic = std::max(plastic, s.values[1][2 * np + i]);
+  std::printf(
+      "elastic gravity loading then Mohr-Coulomb: K0 under the crest within %.3g %% over %zu "
+      "particles; stress change at the switch %.3g of the largest stress; plastic strain %.3g\n",
+      100 * worst_k0, strong.ratio.size(), change / largest, plastic);
+  EXPECT_LT(worst_k0, 0.05);
+  EXPECT_LT(change, 1e-6 * largest);
+  EXPECT_EQ(plastic, 0.0);
+
+  const SlopeSwitch weak = slope_with_switch(5e3, 30.0, true);
+  ASSERT_EQ(weak.run.status, hmpm::RunStatus::successful) << weak.run.message;
+  const hmpm::Series& w = weak.run.series;
+  ASSERT_EQ(w.time.size(), 4u);
+  double yielded = 0.0, after_back = 0.0, elastic_stage = 0.0;
+  for (std::size_t i = 0; i < np; ++i) {
+    elastic_stage = std::max(elastic_stage, w.values[1][1 * np + i]);
+    yielded = std::max(yielded, w.values[1][2 * np + i]);
+    after_back = std::max(after_back, w.values[1][3 * np + i]);
+  }
+  std::printf(
+      "weak Mohr-Coulomb after elastic loading: largest plastic strain %.3g; after the "
+      "switch to a strong material %.3g\n",
+      yielded, after_back);
+  EXPECT_EQ(elastic_stage, 0.0);
+  EXPECT_GT(yielded, 0.0);
+  EXPECT_EQ(after_back, 0.0);  // started again from 0, and the strong material does not yield
+}
+
+// The checks of body_materials, each at its path.
+TEST(Stages, BodyMaterialsAreCheckedAtTheirPaths) {
+  const Excavation c;
+  hmpm::Problem p = excavation(c, 1.0, 10.0);
+  hmpm::Material other = p.materials[0];
+  other.name = "denser";
+  other.density += 100;
+  p.materials.push_back(other);
+  hmpm::Material dry = problems::elastic(c.rho_s, c.E, c.nu);
+  p.materials.push_back(dry);
+  p.stages[0].remove_bodies.clear();
+  p.stages[0].body_materials = {{5, 0}, {0, 9}, {0, 1}, {1, 2}, {1, 0}};
+  std::map<std::string, std::string> issues;
+  for (const hmpm::ProblemIssue& i : hmpm::check_problem(p))
+    issues[i.where.text()] += i.message + " | ";
+  std::string all;
+  for (const auto& [w, m] : issues) all += w + ": " + m + "\n";
+  EXPECT_NE(issues["stages/0/body_materials/0/body"].find("does not exist"), std::string::npos)
+      << all;
+  EXPECT_NE(issues["stages/0/body_materials/1/material"].find("does not exist"), std::string::npos)
+      << all;
+  EXPECT_NE(issues["stages/0/body_materials/2/material"].find("density"), std::string::npos) << all;
+  EXPECT_NE(issues["stages/0/body_materials/3/material"].find("pore water"), std::string::npos)
+      << all;
+  EXPECT_NE(issues["stages/0/body_materials/4/body"].find("twice"), std::string::npos) << all;
 }
 
 }  // namespace

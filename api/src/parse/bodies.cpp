@@ -131,18 +131,8 @@ void read_body(ParseContext& c, const json& j, const std::string& path) {
   Body body;
   body.material = -1;
   if (!r.object(j, path, body_allowed, body_required)) return;
-  if (j.contains("material")) {
-    if (auto name = r.string(j["material"], path + "/material", 100)) {
-      if (auto it = c.material_index.find(*name); it != c.material_index.end()) {
-        body.material = it->second;
-      } else {
-        std::vector<std::string> names;
-        for (const auto& [n, i] : c.material_index) names.push_back(n);
-        r.error(path + "/material", "unknown material '" + *name + "'; defined materials: " +
-                                        (names.empty() ? std::string("none") : quoted_list(names)));
-      }
-    }
-  }
+  if (j.contains("material"))
+    if (auto m = read_material_name(c, j["material"], path + "/material")) body.material = *m;
   std::vector<std::string> shapes;
   for (std::string_view key : shape_keys)
     if (j.contains(key)) shapes.emplace_back(key);
@@ -179,6 +169,17 @@ void read_body(ParseContext& c, const json& j, const std::string& path) {
 }
 
 }  // namespace
+
+std::optional<int> read_material_name(ParseContext& c, const json& j, const std::string& path) {
+  const auto name = c.r.string(j, path, 100);
+  if (!name) return std::nullopt;
+  if (auto it = c.material_index.find(*name); it != c.material_index.end()) return it->second;
+  std::vector<std::string> names;
+  for (const auto& [n, i] : c.material_index) names.push_back(n);
+  c.r.error(path, "unknown material '" + *name + "'; defined materials: " +
+                      (names.empty() ? std::string("none") : quoted_list(names)));
+  return std::nullopt;
+}
 
 void body_keys(std::vector<SpecObjectKeys>& out) {
   out.push_back(keys_entry("/bodies/*", body_allowed));

@@ -373,13 +373,16 @@ void check_limits(ParseContext& c) {
 
 }  // namespace
 
-// output.consolidation without steady_pore_pressure: the hydrostatic
-// pressure under the geostatic water table when the job has one, else 0
-// (with a warning when gravity acts on the pore water).
+// The steady pore pressure of output.consolidation and of the output field
+// excess_pore_pressure, when the spec gives none: the hydrostatic pressure
+// under the geostatic water table when the job has one, else 0 (with a
+// warning when gravity acts on the pore water and either is asked for by
+// name; snapshots of every field take the default silently).
 void resolve_consolidation(ParseContext& c) {
   ConsolidationRequest& out = c.p.output.consolidation;
-  if (!c.consolidation_hydrostatic || !(out.interval > 0)) return;
-  const std::string path = "/output/consolidation";
+  const bool consolidation = out.interval > 0;
+  if (consolidation && !c.consolidation_hydrostatic) return;  // given
+  const std::string path = consolidation ? "/output/consolidation" : c.excess_field_path;
   int axis = -1;
   for (int a = 0; a < 3; ++a)
     if (c.p.gravity[a] != 0) axis = a;
@@ -393,10 +396,13 @@ void resolve_consolidation(ParseContext& c) {
   if (axis < 0 || !rho_f) return;  // no weight of water, or no water: the excess is p itself
   const auto& geo = c.p.initial_state.geostatic;
   if (!geo || !geo->water_table) {
+    if (path.empty()) return;
     const std::string ax(axis_names[axis]);
     std::string advice =
-        "has no steady_pore_pressure, so the excess pore pressure is measured from 0, but "
-        "gravity acts on the pore water: the hydrostatic pressure would count as excess. Give "
+        std::string(consolidation ? "has no steady_pore_pressure" : "has no reference") +
+        ", so the excess pore pressure is measured from 0, but gravity acts on the pore water: "
+        "the hydrostatic pressure would count as excess. Give " +
+        (consolidation ? "" : "initial_state.geostatic.water_table, or output.consolidation.") +
         "steady_pore_pressure the pressure the ground drains to, e.g. \"";
     advice.append(format_number(*rho_f * std::abs(c.p.gravity[axis])))
         .append("*(WT - ")
@@ -407,6 +413,7 @@ void resolve_consolidation(ParseContext& c) {
     return;
   }
   if (mixed) {
+    if (path.empty()) return;  // snapshots of every field: the excess measured from 0
     c.r.error(path,
               "needs steady_pore_pressure: its default, the hydrostatic pressure under "
               "the water table, is ambiguous when the materials' fluid densities differ");

@@ -11,7 +11,8 @@ namespace {
 
 constexpr std::string_view output_allowed[] = {"series", "snapshots", "reactions", "profiles",
                                                "consolidation"};
-constexpr std::string_view profiles_allowed[] = {"interval", "lines"};
+constexpr std::string_view profiles_allowed[] = {"interval", "times", "lines"};
+constexpr std::string_view profiles_required[] = {"lines"};
 constexpr std::string_view line_allowed[] = {"from", "to", "points", "fields"};
 constexpr std::string_view series_allowed[] = {"particles", "fields", "interval"};
 constexpr std::string_view series_required[] = {"particles", "fields"};
@@ -24,7 +25,8 @@ constexpr std::string_view consolidation_allowed[] = {"interval", "from", "stead
                                                       "particles"};
 constexpr std::string_view consolidation_required[] = {"interval"};
 
-std::vector<Field> read_fields(SpecReader& r, const json& j, const std::string& path) {
+std::vector<Field> read_fields(ParseContext& c, const json& j, const std::string& path) {
+  SpecReader& r = c.r;
   std::vector<Field> out;
   if (!r.array(j, path, 1)) return out;
   for (std::size_t i = 0; i < j.size(); ++i) {
@@ -38,6 +40,7 @@ std::vector<Field> read_fields(SpecReader& r, const json& j, const std::string& 
       r.error(fp, "'" + *name + "' is listed twice");
       continue;
     }
+    if (f == Field::excess_pore_pressure && c.excess_field_path.empty()) c.excess_field_path = fp;
     out.push_back(f);
   }
   return out;
@@ -83,14 +86,29 @@ void read_series_particles(ParseContext& c, const json& parts, const std::string
   }
 }
 
-// output.profiles: {"interval", "lines": [{"from", "to", "points", "fields"}]}.
-// The particles nearest to each point are found with the whole problem
-// (resolve_profiles in checks.cpp).
+// output.profiles: {"interval", "times", "lines": [{"from", "to", "points",
+// "fields"}]}. The particles nearest to each point are found with the whole
+// problem (resolve_profiles in checks.cpp); the times are checked against
+// the run's end and their order by check_problem.
 void read_profiles(ParseContext& c, const json& j, const std::string& path) {
   SpecReader& r = c.r;
   OutputRequest& out = c.p.output;
-  if (!r.object(j, path, profiles_allowed, profiles_allowed)) return;
+  if (!r.object(j, path, profiles_allowed, profiles_required)) return;
   r.number_at(j, path, "interval", Range::positive(), out.profile_interval);
+  if (!j.contains("interval") && !j.contains("times"))
+    r.error(path + "/interval", "is required (or give the listed 'times')");
+  if (j.contains("times") && r.array(j["times"], path + "/times", 1)) {
+    const json& times = j["times"];
+    if (times.size() > static_cast<std::size_t>(c.limits.max_series_rows)) {
+      r.error(path + "/times", "lists " + std::to_string(times.size()) +
+                                   " times; the limit (that of the series) is " +
+                                   std::to_string(c.limits.max_series_rows));
+    } else {
+      for (std::size_t i = 0; i < times.size(); ++i)
+        if (auto t = r.number(times[i], child_pointer(path + "/times", i)))
+          out.profile_times.push_back(*t);
+    }
+  }
   if (!j.contains("lines")) return;
   const json& lines = j["lines"];
   const std::string lp = path + "/lines";
@@ -107,7 +125,7 @@ void read_profiles(ParseContext& c, const json& j, const std::string& path) {
     if (e.contains("points"))
       if (auto n = r.integer(e["points"], ip + "/points", 2, c.limits.max_series_particles))
         points = *n;
-    if (e.contains("fields")) line.fields = read_fields(r, e["fields"], ip + "/fields");
+    if (e.contains("fields")) line.fields = read_fields(c, e["fields"], ip + "/fields");
     if (from && to && points >= 2) {
       g.from = *from;
       g.to = *to;
@@ -179,7 +197,7 @@ void read_output(ParseContext& c, const json& j, const std::string& path) {
     const std::string sp = path + "/series";
     if (r.object(s, sp, series_allowed, series_required)) {
       if (s.contains("particles")) read_series_particles(c, s["particles"], sp + "/particles");
-      if (s.contains("fields")) out.series_fields = read_fields(r, s["fields"], sp + "/fields");
+      if (s.contains("fields")) out.series_fields = read_fields(c, s["fields"], sp + "/fields");
       r.number_at(s, sp, "interval", Range::non_negative(), out.series_interval);
     }
   }
@@ -189,7 +207,7 @@ void read_output(ParseContext& c, const json& j, const std::string& path) {
     if (r.object(s, sp, snapshots_allowed, snapshots_required)) {
       r.number_at(s, sp, "interval", Range::positive(), out.snapshot_interval);
       if (s.contains("fields")) {
-        out.snapshot_fields = read_fields(r, s["fields"], sp + "/fields");
+        out.snapshot_fields = read_fields(c, s["fields"], sp + "/fields");
         // Points of the VTU files are the particle positions: always written.
         if (!out.snapshot_fields.empty() &&
             std::find(out.snapshot_fields.begin(), out.snapshot_fields.end(), Field::position) ==

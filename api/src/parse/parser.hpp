@@ -94,6 +94,9 @@ struct ParseContext {
   std::vector<std::string> flux_paths;  ///< "/fluxes/i/particles", for selection errors
   /// output.consolidation without steady_pore_pressure (resolve_consolidation)
   bool consolidation_hydrostatic = false;
+  /// Where excess_pore_pressure is first listed among the output fields
+  /// (its reference is resolved as output.consolidation's); empty: nowhere.
+  std::string excess_field_path;
   bool any_pore_pressure_bc = false;
   std::string first_pore_pressure_bc;
   /// Runnable but worth knowing (e.g. time.implicit with the explicit
@@ -110,6 +113,9 @@ void read_materials(ParseContext& c, const json& j, const std::string& path);
 std::optional<RandomField> read_random_field(ParseContext& c, const json& j,
                                              const std::string& path);
 void read_bodies(ParseContext& c, const json& j, const std::string& path);
+/// A material's name (a body's, a stage's body_materials'): its index, or
+/// an error at `path` naming the defined ones.
+std::optional<int> read_material_name(ParseContext& c, const json& j, const std::string& path);
 void read_boundaries(ParseContext& c, const json& j, const std::string& path);
 void read_tractions(ParseContext& c, const json& j, const std::string& path);
 void read_fluxes(ParseContext& c, const json& j, const std::string& path);

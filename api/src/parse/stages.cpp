@@ -3,7 +3,8 @@
 //   "stages": [{"name": "excavation", "end": 2.0,
 //               "remove_bodies": [1], "add_bodies": [],
 //               "boundaries": [...], "tractions": [...], "fluxes": [...],
-//               "gravity": [...], "time": {...}, "local_damping": ...}, ...]
+//               "gravity": [...], "time": {...}, "local_damping": ...,
+//               "body_materials": [{"body": 0, "material": "clay-mc"}]}, ...]
 //
 // The top level is the first stage (to time.end); each entry a later one,
 // to its own `end` (absolute, after the stage before). What an entry sets
@@ -23,9 +24,10 @@ namespace hmpm::api::parse {
 namespace {
 
 constexpr std::string_view stage_allowed[] = {
-    "name",   "end",     "add_bodies", "remove_bodies", "boundaries",        "tractions",
-    "fluxes", "gravity", "time",       "local_damping", "reset_displacement"};
+    "name",   "end",     "add_bodies", "remove_bodies", "boundaries",         "tractions",
+    "fluxes", "gravity", "time",       "local_damping", "reset_displacement", "body_materials"};
 constexpr std::string_view stage_required[] = {"end"};
+constexpr std::string_view body_material_keys[] = {"body", "material"};
 
 /// Reads into `target` what `read` puts into the top level's `slot`,
 /// leaving the top level as it was.
@@ -47,6 +49,21 @@ std::vector<int> read_body_list(ParseContext& c, const json& j, const std::strin
   return out;
 }
 
+// "body_materials": [{"body": index, "material": name}, ...]: a body's new
+// material from the stage's start (the checks of body, density and pore
+// water are the solver's: check_problem).
+void read_body_materials(ParseContext& c, const json& j, const std::string& path, Stage& s) {
+  if (!c.r.array(j, path, 1)) return;
+  for (std::size_t i = 0; i < j.size(); ++i) {
+    const std::string ip = child_pointer(path, i);
+    const json& e = j[i];
+    if (!c.r.object(e, ip, body_material_keys, body_material_keys)) continue;
+    const auto body = c.r.integer(e["body"], ip + "/body", 0, 65535);
+    const auto material = read_material_name(c, e["material"], ip + "/material");
+    if (body && material) s.body_materials.push_back({static_cast<int>(*body), *material});
+  }
+}
+
 void read_stage(ParseContext& c, const json& j, const std::string& path, Stage& s) {
   if (!c.r.object(j, path, stage_allowed, stage_required)) return;
   if (j.contains("name"))
@@ -56,6 +73,8 @@ void read_stage(ParseContext& c, const json& j, const std::string& path, Stage& 
     s.add_bodies = read_body_list(c, j["add_bodies"], path + "/add_bodies");
   if (j.contains("remove_bodies"))
     s.remove_bodies = read_body_list(c, j["remove_bodies"], path + "/remove_bodies");
+  if (j.contains("body_materials"))
+    read_body_materials(c, j["body_materials"], path + "/body_materials", s);
   if (j.contains("reset_displacement"))
     if (auto b = c.r.boolean(j["reset_displacement"], path + "/reset_displacement"))
       s.reset_displacement = *b;
@@ -98,6 +117,7 @@ void read_stage(ParseContext& c, const json& j, const std::string& path, Stage& 
 
 void stage_keys(std::vector<SpecObjectKeys>& out) {
   out.push_back(keys_entry("/stages/*", stage_allowed));
+  out.push_back(keys_entry("/stages/*/body_materials/*", body_material_keys));
 }
 
 void read_stages(ParseContext& c, const json& j, const std::string& path) {

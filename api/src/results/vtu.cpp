@@ -140,6 +140,8 @@ const std::vector<double>* snapshot_array(const Snapshot& s, Field f) {
       return &s.friction_angle;
     case Field::hydraulic_conductivity:
       return &s.hydraulic_conductivity;
+    case Field::excess_pore_pressure:
+      return &s.excess_pore_pressure;
   }
   return nullptr;
 }
@@ -190,6 +192,9 @@ void write_snapshot_vtu(const fs::path& path, const Snapshot& s,
   if (s.material.size() == n)
     data_array<std::int32_t>(out, "Int32", "material", 1, n,
                              [&](std::size_t i) { return s.material[i]; });
+  if (s.id.size() == n)
+    data_array<std::int64_t>(out, "Int64", "particle_id", 1, n,
+                             [&](std::size_t i) { return s.id[i]; });
   out << "      </PointData>\n      <Points>\n";
   const bool have_points = s.position.size() == 3 * n;
   data_array<double>(out, "Float64", "Points", 3, n,

@@ -37,6 +37,7 @@ enum class Field : std::uint8_t {
   cohesion,
   friction_angle,
   hydraulic_conductivity,
+  excess_pore_pressure,
 };
 
 /// scalar: 1 component; vector: one per axis (dim); tensor: 6 in Voigt
@@ -51,7 +52,7 @@ struct FieldInfo {
 };
 
 /// Every field, in the order of the Field enumerators.
-inline constexpr std::array<FieldInfo, 14> field_table{{
+inline constexpr std::array<FieldInfo, 15> field_table{{
     {Field::position, "position", FieldKind::vector, "m"},
     {Field::displacement, "displacement", FieldKind::vector, "m"},
     {Field::velocity, "velocity", FieldKind::vector, "m/s"},
@@ -71,6 +72,11 @@ inline constexpr std::array<FieldInfo, 14> field_table{{
     {Field::cohesion, "cohesion", FieldKind::scalar, "Pa"},
     {Field::friction_angle, "friction_angle", FieldKind::scalar, "deg"},
     {Field::hydraulic_conductivity, "hydraulic_conductivity", FieldKind::scalar, "m/s"},
+    // The pore pressure minus the steady one at the particle's current
+    // position (output.consolidation's reference: its steady_pore_pressure,
+    // else the hydrostatic pressure under the geostatic water table, else
+    // 0); zero where the material has no pore water.
+    {Field::excess_pore_pressure, "excess_pore_pressure", FieldKind::scalar, "Pa"},
 }};
 inline constexpr int field_count = static_cast<int>(field_table.size());
 

@@ -416,10 +416,15 @@ struct OutputRequest {
   /// of the steps that reach each multiple of it (RunResult::reactions);
   /// <= 0: none.
   double reactions_interval = 0.0;
-  /// Profiles, each sampled (like a series) at t = 0 and at the end of the
-  /// steps that reach each multiple of profile_interval (> 0 when any).
+  /// Profiles, each sampled (like a series) at t = 0, at the end of the
+  /// steps that reach each multiple of profile_interval (> 0: an interval)
+  /// and at the end of the steps that reach each of profile_times (s,
+  /// increasing, in the run; isochrones). One of the two when any. The
+  /// quasi-static scheme's growing steps land on both exactly; fixed steps
+  /// sample at the end of the first step that reaches the time.
   std::vector<ProfileLine> profiles;
   double profile_interval = 0.0;
+  std::vector<double> profile_times;
   ConsolidationRequest consolidation;  ///< none unless its interval > 0
 };
 
@@ -436,6 +441,17 @@ struct Stage {
   std::vector<int> add_bodies;
   /// Bodies whose particles leave the run at the stage's start (excavation).
   std::vector<int> remove_bodies;
+  /// A body's new material at the stage's start: (body index, material
+  /// index), e.g. elastic gravity loading, then Mohr-Coulomb. Its particles
+  /// keep their stress, pore pressure, porosity, mass and displacement;
+  /// their plastic strain and internal state variables start again from 0.
+  /// The new material has the same density and pore water (hydraulic or
+  /// not, porosity, fluid density) as the one in force.
+  struct BodyMaterial {
+    int body = 0;
+    int material = 0;
+  };
+  std::vector<BodyMaterial> body_materials;
   std::optional<std::vector<Boundary>> boundaries;
   std::optional<std::vector<Traction>> tractions;
   std::optional<std::vector<Flux>> fluxes;

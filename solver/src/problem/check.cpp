@@ -281,6 +281,55 @@ namespace {
 /// Problem runnable: its issues, where the top level does not have them
 /// already, at the stage (a list it sets at its own path; one in force
 /// from before at the stage, naming it).
+// Stage i's new materials of bodies: a body and a material that exist, the
+// body given one material, and a material whose density and pore water are
+// those of the one in force (the particles keep their mass, porosity and
+// pore pressure).
+void check_body_materials(const Problem& problem, std::size_t i,
+                          std::vector<ProblemIssue>& issues) {
+  const std::vector<Stage::BodyMaterial>& list = problem.stages[i].body_materials;
+  const Problem before = stage_problem(problem, i);
+  const std::size_t materials = problem.materials.size();
+  for (std::size_t k = 0; k < list.size(); ++k) {
+    const Location at = Location{"stages"} / i / "body_materials" / k;
+    const Stage::BodyMaterial& bm = list[k];
+    if (bm.body < 0 || static_cast<std::size_t>(bm.body) >= problem.bodies.size()) {
+      issues.push_back({at / "body", "body " + std::to_string(bm.body) +
+                                         " does not exist; there are " +
+                                         std::to_string(problem.bodies.size()) + " bodies"});
+      continue;
+    }
+    for (std::size_t e = 0; e < k; ++e)
+      if (list[e].body == bm.body)
+        issues.push_back({at / "body", "body " + std::to_string(bm.body) +
+                                           " is given a material twice in this stage"});
+    if (bm.material < 0 || static_cast<std::size_t>(bm.material) >= materials) {
+      issues.push_back({at / "material", "material " + std::to_string(bm.material) +
+                                             " does not exist; there are " +
+                                             std::to_string(materials) + " materials"});
+      continue;
+    }
+    const Material& from = problem.materials[static_cast<std::size_t>(
+        before.bodies[static_cast<std::size_t>(bm.body)].material)];
+    const Material& to = problem.materials[static_cast<std::size_t>(bm.material)];
+    std::string differs;
+    if (to.density != from.density) differs = "density";
+    if (to.hydraulic.has_value() != from.hydraulic.has_value())
+      differs = to.hydraulic ? "pore water (hydraulic)" : "pore water (no hydraulic)";
+    else if (to.hydraulic && (to.hydraulic->porosity != from.hydraulic->porosity ||
+                              to.hydraulic->fluid_density != from.hydraulic->fluid_density))
+      differs = "porosity or fluid density";
+    if (!differs.empty())
+      issues.push_back(
+          {at / "material",
+           "'" + to.name + "' differs from '" + from.name + "', the body's material in force, in " +
+               differs +
+               ": the particles keep their mass and pore water, so the new material must have "
+               "the same density, porosity and fluid density (change the model and its "
+               "strength and stiffness parameters only)"});
+  }
+}
+
 void check_stages(const Problem& problem, std::vector<ProblemIssue>& issues) {
   if (problem.stages.empty()) return;
   std::vector<std::string> top;
@@ -317,6 +366,7 @@ void check_stages(const Problem& problem, std::vector<ProblemIssue>& issues) {
     };
     bodies(st.add_bodies, "add_bodies", true);
     bodies(st.remove_bodies, "remove_bodies", false);
+    check_body_materials(problem, i, issues);
     const std::vector<bool> after = stage_bodies(problem, i + 1);
     if (std::none_of(after.begin(), after.end(), [](bool b) { return b; }))
       issues.push_back({at / "remove_bodies", "leaves no body in the run"});
@@ -334,6 +384,8 @@ void check_stages(const Problem& problem, std::vector<ProblemIssue>& issues) {
     // output.consolidation is the job's (its `from` may lie in a later
     // stage): checked once, with the whole job.
     in_force.output.consolidation = ConsolidationRequest{};
+    // So are output.profiles' times (any may lie in a later stage).
+    if (!in_force.output.profile_times.empty()) in_force.output.profile_times = {0.0};
     for (const ProblemIssue& issue : check_problem(in_force)) {
       const std::string text = issue.where.text() + ": " + issue.message;
       if (std::find(top.begin(), top.end(), text) != top.end()) continue;
@@ -497,8 +549,19 @@ std::vector<ProblemIssue> check_problem(const Problem& problem) {
     if (out.profiles[l].particles.empty() || out.profiles[l].fields.empty())
       add(where, "needs particles and fields");
   }
-  if (!out.profiles.empty() && !(out.profile_interval > 0))
-    add({"output", "profiles", "interval"}, "must be > 0");
+  if (!out.profiles.empty() && !(out.profile_interval > 0) && out.profile_times.empty())
+    add({"output", "profiles", "interval"}, "must be > 0 (or give the profiles' times)");
+  const double job_end = job_end_time(problem);
+  for (std::size_t k = 0; k < out.profile_times.size(); ++k) {
+    const double tk = out.profile_times[k];
+    const Location where = Location{"output", "profiles", "times"} / k;
+    if (!(tk >= 0 && tk <= job_end))
+      add(where, "is " + format4(tk) + " s; it must be in [0, " + format4(job_end) +
+                     "] s, inside the run (the job ends at t = " + format4(job_end) + " s)");
+    else if (k > 0 && !(tk > out.profile_times[k - 1]))
+      add(where, "is " + format4(tk) + " s, not after the time before it (" +
+                     format4(out.profile_times[k - 1]) + " s): list the times in increasing order");
+  }
   check_consolidation(problem, issues);
   const bool adds = std::any_of(problem.stages.begin(), problem.stages.end(),
                                 [](const Stage& st) { return !st.add_bodies.empty(); });

@@ -20,6 +20,9 @@ Problem stage_problem(const Problem& problem, std::size_t k) {
     if (s.gravity) out.gravity = *s.gravity;
     if (s.time) out.time = *s.time;
     if (s.local_damping) out.local_damping = *s.local_damping;
+    for (const Stage::BodyMaterial& bm : s.body_materials)
+      if (bm.body >= 0 && static_cast<std::size_t>(bm.body) < out.bodies.size())
+        out.bodies[static_cast<std::size_t>(bm.body)].material = bm.material;
     out.time.start = previous_end;
     out.time.end = s.end;
   }

@@ -101,6 +101,19 @@ void check_quasi_static(const Problem& problem, const StableStep&,
       issues.push_back({{"time", "dt", "max"}, "must be >= initial (" + fmt(g.initial) + " s)"});
     if (!(g.growth >= 1.0)) issues.push_back({{"time", "dt", "growth"}, "must be >= 1 (e.g. 1.2)"});
   }
+  // Friction walls: the scheme's Newton system has no Coulomb slip (no
+  // active set of sticking and slipping nodes), so a friction wall would
+  // act as frictionless; refused rather than run as something else.
+  for (std::size_t i = 0; i < problem.boundaries.size(); ++i)
+    if (problem.boundaries[i].friction)
+      issues.push_back(
+          {Location{"boundaries"} / i / "friction",
+           "is not supported by the quasi-static scheme: its Newton iterations have no "
+           "Coulomb slip, so the wall would act as frictionless. For a wall that does not slip "
+           "(a rough base), prescribe its tangential velocity too (e.g. \"velocity\": [0, 0]) "
+           "and remove friction; for a smooth one, remove friction; for Coulomb slip use the "
+           "explicit or semi_implicit scheme (a staged job can load gravity quasi-statically on "
+           "a fixed base and then switch scheme and boundaries)"});
   const ImplicitControl& c = t.implicit;
   if (!(c.tolerance > 0 && c.tolerance < 1))
     issues.push_back({{"time", "implicit", "tolerance"}, "must be in (0, 1), e.g. 1e-8"});

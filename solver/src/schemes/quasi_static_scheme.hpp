@@ -43,9 +43,10 @@
 // Boundary conditions: prescribed velocity components give prescribed
 // increments (the trapezoidal integral of the velocity over the step),
 // rigid ties share one degree of freedom per tied axis (prescribed
-// components win, as in boundary/apply.hpp), friction walls act as
-// frictionless (only their normal component is prescribed), prescribed pore
-// pressures take their value at t + dt.
+// components win, as in boundary/apply.hpp), friction walls are refused by
+// the scheme's checks (quasi_static_rules.cpp: there is no Coulomb slip
+// here; were one to reach the scheme, only its normal component would be
+// prescribed), prescribed pore pressures take their value at t + dt.
 //
 // Threads: the residual and Jacobian assembly takes one fixed chunk of
 // particles per solver thread, each extra thread into private copies of the
@@ -127,6 +128,11 @@ class QuasiStaticScheme final : public TimeScheme {
               : first + (std::floor((t - first) / interval + 1e-9) + 1.0) * interval;
       if (t + 1.25 * h >= next - 1e-9 * interval) h = std::min(h * 1.25, next - t);
     }
+    // The profiles' listed times (isochrones), the next one after t.
+    const auto listed = std::upper_bound(out.profile_times.begin(), out.profile_times.end(),
+                                         t + 1e-9 * std::max(h, t));
+    if (listed != out.profile_times.end() && t + 1.25 * h >= *listed - 1e-9 * h)
+      h = std::min(h * 1.25, *listed - t);
     nominal_ = std::min(growth_.max, nominal_ * growth_.growth);
     return h;
   }
