@@ -249,6 +249,11 @@ class Simulation {
   /// their new material; plastic strain and internal state start from 0.
   void switch_materials(const Stage& stage);
 
+  // ------------------------------------------------------------ after the stages
+  /// Problem::strength_reduction from the state at time t
+  /// (strength_reduction.hpp): the factor of safety into `result`.
+  void reduce_strength(RunResult& result, double t, const RunOptions& options);
+
   // ------------------------------------------------------------ output (output.hpp)
   void fill_snapshot(Snapshot& snap, const std::vector<Field>& fields) const;
   /// Particle p's pore pressure minus the steady one at its current position
