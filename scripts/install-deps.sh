@@ -8,7 +8,9 @@ packages=(
   build-essential cmake ninja-build pkg-config git curl   # ninja: parallel builds (scripts/build.sh)
   libeigen3-dev            # solver: linear algebra (header only)
   libsuitesparse-dev       # solver: CHOLMOD and UMFPACK, the quasi-static u-p solves (linear/)
-  libmetis-dev             # bench: METIS orderings compared in docs/performance.md (CHOLMOD links libmetis5)
+  libmetis-dev             # solver: METIS nested dissection for MUMPS (linear/up_system.cpp)
+  libmumps-seq-dev         # solver: MUMPS LDL^T of large quasi-static u-p systems (optional in CMake)
+  libopenblas-serial-dev   # solver: an optimised single-threaded BLAS for MUMPS's fronts
   nlohmann-json3-dev       # api: JSON parsing
   libmuparser-dev          # api: expressions in job specs
   libsqlite3-dev           # server: job store

@@ -88,10 +88,31 @@ class UpSystem {
   enum class Method { none, ldlt, lu, iterative };
   Method method() const { return method_; }
 
+  /// Systems of large_system unknowns or more (set_large_above: tests) take
+  /// the faster factorisation for large systems, MUMPS's LDL^T, when the
+  /// build has it (HMPM_HAVE_MUMPS; it pivots, so symmetric indefinite
+  /// values take it too), and reuse a factor for changed values (Newton
+  /// iterations after the first, later steps in the same pattern): GMRES
+  /// preconditioned by it, to reuse_tolerance of |b| within
+  /// reuse_iterations, else a new factor. Below, neither pays (measured,
+  /// docs/performance.md): MUMPS's analysis and a GMRES iteration cost
+  /// more there than CHOLMOD's factor.
+  static constexpr std::int64_t large_system = 20000;
+  static constexpr int reuse_iterations = 10;
+  static constexpr double reuse_tolerance = 1e-11;
+  void set_large_above(std::int64_t n) {
+    large_above_ = n;
+    factored_ = Method::none;
+    ldlt_analysed_ = false;
+  }
+  /// True when the symmetric factorisation of this size is MUMPS's.
+  bool mumps() const;
+
   std::int64_t linear_iterations = 0;  ///< iterative solves: summed iterations
   std::int64_t solves = 0;
   // Cumulated, for benchmarks (not saved in checkpoints).
-  std::int64_t analyses = 0, factorisations = 0;  ///< symbolic / numeric
+  std::int64_t analyses = 0, factorisations = 0;        ///< symbolic / numeric
+  std::int64_t reuses = 0, reuse_gmres_iterations = 0;  ///< solves by an older factor
   double factor_seconds = 0.0, solve_seconds = 0.0;
 
  private:
@@ -103,6 +124,8 @@ class UpSystem {
   bool solve_ldlt(const Eigen::VectorXd& b, Eigen::VectorXd& x);
   bool solve_lu(const Eigen::VectorXd& b, Eigen::VectorXd& x);
   bool solve_iterative(const Eigen::VectorXd& b, Eigen::VectorXd& x);
+  bool solve_reusing(const Eigen::VectorXd& b, Eigen::VectorXd& x);
+  void apply_factor(const Eigen::VectorXd& r, Eigen::VectorXd& z);
 
   std::int64_t n_ = 0;
   bool iterative_ = false;
@@ -111,6 +134,8 @@ class UpSystem {
   bool ldlt_analysed_ = false, lu_analysed_ = false;
   Method factored_ = Method::none;  ///< the factor that holds factored_values_
   Method method_ = Method::none;
+  std::int64_t large_above_ = large_system;
+  bool reuse_failed_ = false;
   std::vector<double> factored_values_;
   // The pattern the factorisations analysed, and each entry's mirror (the
   // position of (c, r) for entry (r, c); -1: none, the pattern unsymmetric).
