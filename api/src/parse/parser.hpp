@@ -92,6 +92,8 @@ struct ParseContext {
   std::size_t formulas = 0;             ///< formulas read so far
   std::vector<std::string> traction_paths;
   std::vector<std::string> flux_paths;  ///< "/fluxes/i/particles", for selection errors
+  /// "/surface_pressures/i/particles", for selection errors
+  std::vector<std::string> surface_pressure_paths;
   /// output.consolidation without steady_pore_pressure (resolve_consolidation)
   bool consolidation_hydrostatic = false;
   bool any_pore_pressure_bc = false;
@@ -110,6 +112,7 @@ void read_bodies(ParseContext& c, const json& j, const std::string& path);
 void read_boundaries(ParseContext& c, const json& j, const std::string& path);
 void read_tractions(ParseContext& c, const json& j, const std::string& path);
 void read_fluxes(ParseContext& c, const json& j, const std::string& path);
+void read_surface_pressures(ParseContext& c, const json& j, const std::string& path);
 void read_time(ParseContext& c, const json& j, const std::string& path);
 void read_local_damping(ParseContext& c, const json& j, const std::string& path);
 void read_initial_state(ParseContext& c, const json& j, const std::string& path);
@@ -200,6 +203,7 @@ void body_keys(std::vector<SpecObjectKeys>& out);
 void boundary_keys(std::vector<SpecObjectKeys>& out);
 void traction_keys(std::vector<SpecObjectKeys>& out);
 void flux_keys(std::vector<SpecObjectKeys>& out);
+void surface_pressure_keys(std::vector<SpecObjectKeys>& out);
 void initial_state_keys(std::vector<SpecObjectKeys>& out);
 void time_keys(std::vector<SpecObjectKeys>& out);
 void output_keys(std::vector<SpecObjectKeys>& out);

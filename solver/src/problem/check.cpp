@@ -359,6 +359,10 @@ std::vector<ProblemIssue> check_problem(const Problem& problem) {
     if (problem.fluxes[i].polygon)
       check_selection_polygon(problem, *problem.fluxes[i].polygon,
                               Location{"fluxes"} / i / "particles" / "polygon", issues);
+  for (std::size_t i = 0; i < problem.surface_pressures.size(); ++i)
+    if (problem.surface_pressures[i].polygon)
+      check_selection_polygon(problem, *problem.surface_pressures[i].polygon,
+                              Location{"surface_pressures"} / i / "particles" / "polygon", issues);
   if (issues.size() > before_shapes) return issues;
   const std::vector<BodyLayout> layouts = body_layouts(problem, LayoutDetail::counts);
   for (std::size_t b = 0; b < problem.bodies.size(); ++b) {
