@@ -320,6 +320,11 @@ std::vector<ProblemIssue> check_problem(const Problem& problem) {
   for (int a = 0; a < dim; ++a) {
     if (problem.grid.cells[a] < 1)
       add(Location{"grid", "cells"} / static_cast<std::size_t>(a), "must be >= 1");
+    else if (problem.grid.cells[a] < 2 && problem.shape_function != ShapeFunction::linear)
+      // A 3-node stencil spans three node columns: one cell has two (the
+      // stencil's first node fell outside the grid).
+      add(Location{"grid", "cells"} / static_cast<std::size_t>(a),
+          "must be >= 2 with shape_function gimp or bspline (their stencil spans 3 nodes)");
     if (!(problem.grid.max[a] > problem.grid.min[a]))
       add(Location{"grid", "max"} / static_cast<std::size_t>(a), "must be greater than grid.min");
   }
