@@ -50,6 +50,7 @@
 #include <vector>
 
 #include "boundary/constraints.hpp"
+#include "boundary/surface_pressures.hpp"
 #include "boundary/tractions.hpp"
 #include "failures.hpp"
 #include "hmpm/problem.hpp"
@@ -76,7 +77,8 @@ struct RunModel {
   /// absorbing base's forces at rest) change during a step.
   mutable Constraints constraints;
   std::vector<TractionLoad> tractions;
-  std::vector<FluxLoad> fluxes;  ///< saturated runs only
+  std::vector<FluxLoad> fluxes;                        ///< saturated runs only
+  std::vector<SurfacePressureLoad> surface_pressures;  ///< saturated runs only
   Vec gravity = Vec::Zero();
   Vec grid_max = Vec::Zero();
   bool fluid = false;

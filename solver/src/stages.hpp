@@ -87,7 +87,11 @@ void Simulation<Dim, Shape>::enter_stage(std::size_t k) {
   model_.constraints =
       compile_constraints<Dim>(model_.problem, grid_, model_.grid_max, model_.fluid, particles_);
   model_.tractions = compile_tractions<Dim>(model_.problem, particles_, volume0, grid_);
-  if (model_.fluid) model_.fluxes = compile_fluxes<Dim>(model_.problem, particles_, volume0, grid_);
+  if (model_.fluid) {
+    model_.fluxes = compile_fluxes<Dim>(model_.problem, particles_, volume0, grid_);
+    model_.surface_pressures =
+        compile_surface_pressures<Dim>(model_.problem, particles_, volume0, grid_);
+  }
   if (model_.problem.output.reactions_interval > 0)
     setup_reactions<Dim>(reactions_, model_.constraints, grid_.count,
                          model_.problem.boundaries.size());

@@ -267,6 +267,7 @@ void check_face_selections(ParseContext& c, const std::vector<Load>& loads,
 void check_traction_selections(ParseContext& c) {
   check_face_selections(c, c.p.tractions, c.traction_paths);
   check_face_selections(c, c.p.fluxes, c.flux_paths);
+  check_face_selections(c, c.p.surface_pressures, c.surface_pressure_paths);
 }
 
 void check_time_formulas(ParseContext& c) {

@@ -16,12 +16,25 @@ namespace hmpm::api {
 namespace parse {
 namespace {
 
-constexpr std::string_view top_allowed[] = {
-    "name",           "description",       "dimension",     "grid",
-    "shape_function", "materials",         "bodies",        "gravity",
-    "boundaries",     "tractions",         "time",          "output",
-    "local_damping",  "gravity_constant",  "initial_state", "fluxes",
-    "stages",         "strength_reduction"};
+constexpr std::string_view top_allowed[] = {"name",
+                                            "description",
+                                            "dimension",
+                                            "grid",
+                                            "shape_function",
+                                            "materials",
+                                            "bodies",
+                                            "gravity",
+                                            "boundaries",
+                                            "tractions",
+                                            "time",
+                                            "output",
+                                            "local_damping",
+                                            "gravity_constant",
+                                            "initial_state",
+                                            "fluxes",
+                                            "stages",
+                                            "strength_reduction",
+                                            "surface_pressures"};
 constexpr std::string_view top_required[] = {"dimension", "grid", "materials", "bodies", "time"};
 // At most this many errors are reported (then one line counting the rest).
 constexpr std::size_t max_errors = 1000;
@@ -102,6 +115,8 @@ void read_root(ParseContext& c, const json& root) {
   if (root.contains("boundaries")) read_boundaries(c, root["boundaries"], "/boundaries");
   if (root.contains("tractions")) read_tractions(c, root["tractions"], "/tractions");
   if (root.contains("fluxes")) read_fluxes(c, root["fluxes"], "/fluxes");
+  if (root.contains("surface_pressures"))
+    read_surface_pressures(c, root["surface_pressures"], "/surface_pressures");
   if (root.contains("time")) read_time(c, root["time"], "/time");
   if (root.contains("initial_state"))
     read_initial_state(c, root["initial_state"], "/initial_state");
@@ -171,6 +186,7 @@ const std::vector<SpecObjectKeys>& spec_object_keys() {
     parse::boundary_keys(t);
     parse::traction_keys(t);
     parse::flux_keys(t);
+    parse::surface_pressure_keys(t);
     parse::initial_state_keys(t);
     parse::time_keys(t);
     parse::strength_reduction_keys(t);

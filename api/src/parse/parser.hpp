@@ -92,6 +92,8 @@ struct ParseContext {
   std::size_t formulas = 0;             ///< formulas read so far
   std::vector<std::string> traction_paths;
   std::vector<std::string> flux_paths;  ///< "/fluxes/i/particles", for selection errors
+  /// "/surface_pressures/i/particles", for selection errors
+  std::vector<std::string> surface_pressure_paths;
   /// output.consolidation without steady_pore_pressure (resolve_consolidation)
   bool consolidation_hydrostatic = false;
   /// Where excess_pore_pressure is first listed among the output fields
@@ -119,6 +121,7 @@ std::optional<int> read_material_name(ParseContext& c, const json& j, const std:
 void read_boundaries(ParseContext& c, const json& j, const std::string& path);
 void read_tractions(ParseContext& c, const json& j, const std::string& path);
 void read_fluxes(ParseContext& c, const json& j, const std::string& path);
+void read_surface_pressures(ParseContext& c, const json& j, const std::string& path);
 void read_time(ParseContext& c, const json& j, const std::string& path);
 void read_strength_reduction(ParseContext& c, const json& j, const std::string& path);
 void read_local_damping(ParseContext& c, const json& j, const std::string& path);
@@ -210,6 +213,7 @@ void body_keys(std::vector<SpecObjectKeys>& out);
 void boundary_keys(std::vector<SpecObjectKeys>& out);
 void traction_keys(std::vector<SpecObjectKeys>& out);
 void flux_keys(std::vector<SpecObjectKeys>& out);
+void surface_pressure_keys(std::vector<SpecObjectKeys>& out);
 void initial_state_keys(std::vector<SpecObjectKeys>& out);
 void time_keys(std::vector<SpecObjectKeys>& out);
 void strength_reduction_keys(std::vector<SpecObjectKeys>& out);

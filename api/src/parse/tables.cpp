@@ -35,6 +35,7 @@ std::string spec_tables_json() {
       {"/materials/*/model", list(parse::material_model_names())},
       {"/tractions/*/face", list(parse::traction_faces())},
       {"/fluxes/*/face", list(parse::traction_faces())},
+      {"/surface_pressures/*/face", list(parse::traction_faces())},
       {"/time/scheme", list(parse::scheme_names())},
       {"/time/implicit/linear_solver", list(parse::linear_solver_names())},
       {"/output/series/fields/*", list(parse::field_names())},

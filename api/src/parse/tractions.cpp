@@ -1,5 +1,6 @@
-// tractions.cpp — the "tractions" and "fluxes" sections: surface loads and
-// water flowing across a face of the particles inside a box or a polygon.
+// tractions.cpp — the "tractions", "fluxes" and "surface_pressures"
+// sections: surface loads, water flowing across a face, and pore pressures
+// prescribed on a face of the particles inside a box or a polygon.
 #include "parser.hpp"
 
 namespace hmpm::api::parse {
@@ -7,6 +8,8 @@ namespace {
 
 constexpr std::string_view traction_allowed[] = {"particles", "face", "traction"};
 constexpr std::string_view flux_allowed[] = {"particles", "face", "rate"};
+constexpr std::string_view surface_allowed[] = {"particles", "face", "pore_pressure", "seepage"};
+constexpr std::string_view surface_required[] = {"particles", "face"};
 constexpr std::string_view face_names[] = {"x-", "x+", "y-", "y+", "z-", "z+"};
 
 // "particles" and "face" of a traction or a flux.
@@ -65,7 +68,40 @@ void read_flux(ParseContext& c, const json& j, const std::string& path) {
   c.p.fluxes.push_back(std::move(f));
 }
 
+void read_surface_pressure(ParseContext& c, const json& j, const std::string& path) {
+  SpecReader& r = c.r;
+  if (!r.object(j, path, surface_allowed, surface_required)) return;
+  SurfacePressure s;
+  read_face(c, j, path, s);
+  if (j.contains("pore_pressure")) {
+    bool varies = false;
+    if (auto f = read_value_of_space_time(c, j["pore_pressure"], path + "/pore_pressure", varies))
+      s.pore_pressure = std::move(*f);
+  }
+  if (j.contains("seepage"))
+    if (const auto v = r.boolean(j["seepage"], path + "/seepage")) s.seepage = *v;
+  if (j.contains("seepage") && j.contains("pore_pressure"))
+    r.error(path + "/seepage",
+            "cannot share an entry with pore_pressure: a seepage face decides its own pressure "
+            "(p = 0 while water leaves); give the prescribed pressure its own entry");
+  else if (!s.seepage && !j.contains("pore_pressure"))
+    r.error(path, "needs 'pore_pressure' (a number or a formula in x, y, z, t) or 'seepage': true");
+  c.surface_pressure_paths.push_back(path + "/particles");
+  c.p.surface_pressures.push_back(std::move(s));
+}
+
 }  // namespace
+
+void surface_pressure_keys(std::vector<SpecObjectKeys>& out) {
+  out.push_back(keys_entry("/surface_pressures/*", surface_allowed));
+  out.push_back(keys_entry("/surface_pressures/*/particles", selection_key_names()));
+  out.push_back(keys_entry("/surface_pressures/*/particles/box", box_key_names()));
+}
+
+void read_surface_pressures(ParseContext& c, const json& j, const std::string& path) {
+  if (!c.r.array(j, path)) return;
+  for (std::size_t i = 0; i < j.size(); ++i) read_surface_pressure(c, j[i], child_pointer(path, i));
+}
 
 void flux_keys(std::vector<SpecObjectKeys>& out) {
   out.push_back(keys_entry("/fluxes/*", flux_allowed));

@@ -279,6 +279,26 @@ struct Flux {
   bool rate_varies_in_space = false;
 };
 
+/// A pore pressure prescribed on one face of the particles inside
+/// `particles` (or `polygon`): the soil's own surface wherever it lies in
+/// the grid and as it moves (a drained ground surface, a reservoir, a river).
+/// Each selected particle exchanges water with the face through the
+/// half-particle between its centre and the face (a Robin condition,
+/// docs/job-spec.md "where to put drained boundaries"): into the soil at
+/// (k/gamma_w) (p_face - p_particle) / (l/2) per unit area, l the particle's
+/// current length along the normal. A seepage face has p_face = 0 and only
+/// lets water out.
+struct SurfacePressure {
+  Box particles;                   ///< closed box of initial positions; used when no polygon
+  std::optional<Polygon> polygon;  ///< 2D: replaces the box when set
+  int axis = 0;                    ///< face normal axis
+  int side = +1;                   ///< +1 for "x+", -1 for "x-"
+  /// Pa at (the face's current centre, t); empty with `seepage`.
+  FieldOfSpaceTime pore_pressure;
+  /// A seepage face: water leaves at p = 0, never enters.
+  bool seepage = false;
+};
+
 /// Geostatic initial state of horizontally layered ground (verification §6).
 /// The vertical axis is the axis of gravity (the only non-zero component);
 /// "above" is against gravity. At every particle, from the bodies stacked
@@ -505,6 +525,8 @@ struct Problem {
   std::vector<Boundary> boundaries;
   std::vector<Traction> tractions;
   std::vector<Flux> fluxes;  ///< saturated runs only (check_problem)
+  /// Pore pressures on the faces of particles (saturated runs only).
+  std::vector<SurfacePressure> surface_pressures;
   TimeControl time;
   OutputRequest output;
   /// Acceleration of gravity used for the unit weight of water gamma_w = rho_f * g.

@@ -139,6 +139,8 @@ bool node_selected(const Problem& problem, const NodeSelection& nodes, const Vec
 bool particle_selected(const Problem& problem, const Traction& traction, const Vec3& x);
 /// The same for a flux.
 bool particle_selected(const Problem& problem, const Flux& flux, const Vec3& x);
+/// The same for a surface pressure.
+bool particle_selected(const Problem& problem, const SurfacePressure& s, const Vec3& x);
 /// Whether output.consolidation counts the particle initially at x (its
 /// selection; pore water aside).
 bool particle_selected(const Problem& problem, const ConsolidationRequest& c, const Vec3& x);

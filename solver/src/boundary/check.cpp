@@ -26,7 +26,7 @@ void check_friction_boundaries(const Problem& problem, std::vector<ProblemIssue>
   }
 }
 
-// Fluxes and seepage faces: they act on the pore water, so they need a
+// Fluxes, surface pressures and seepage faces: they act on the pore water, so they need a
 // saturated material (every scheme has both).
 void check_hydraulic_boundaries(const Problem& problem, std::vector<ProblemIssue>& issues) {
   const bool saturated = std::any_of(problem.materials.begin(), problem.materials.end(),
@@ -41,6 +41,19 @@ void check_hydraulic_boundaries(const Problem& problem, std::vector<ProblemIssue
     if (f.axis < 0 || f.axis >= problem.dimension)
       issues.push_back({w / "face", "names an axis this " + std::to_string(problem.dimension) +
                                         "D problem does not have"});
+  }
+  for (std::size_t i = 0; i < problem.surface_pressures.size(); ++i) {
+    const SurfacePressure& s = problem.surface_pressures[i];
+    const Location w = Location{"surface_pressures"} / i;
+    if (!saturated)
+      issues.push_back({w,
+                        "acts on pore water, but no material has `hydraulic` (a dry run has "
+                        "none): give the soil's material a hydraulic section or remove it"});
+    if (s.axis < 0 || s.axis >= problem.dimension)
+      issues.push_back({w / "face", "names an axis this " + std::to_string(problem.dimension) +
+                                        "D problem does not have"});
+    if (s.seepage == static_cast<bool>(s.pore_pressure))
+      issues.push_back({w, "needs exactly one of pore_pressure (a value) and seepage: true"});
   }
   for (std::size_t i = 0; i < problem.boundaries.size(); ++i) {
     const Boundary& b = problem.boundaries[i];

@@ -56,7 +56,10 @@ struct PressureConstraint {
   std::vector<std::int64_t> nodes;
   const FieldOfTime* fn = nullptr;
   const FieldOfSpaceTime* field = nullptr;
-  std::vector<Vec3> x;  ///< node positions (only with `field`)
+  std::vector<Vec3> x;       ///< node positions (only with `field`)
+  std::size_t boundary = 0;  ///< index in Problem::boundaries (for messages)
+  /// Some node had soil at a step of the stage (check_drained_contact).
+  bool reached = false;
 
   /// Calls set(node, value) for every node at time t.
   template <class Set>
@@ -89,6 +92,8 @@ struct AbsorbingConstraint {
 /// a boundary prescribes (a prescribed value wins).
 struct SeepageFace {
   std::vector<std::int64_t> nodes;
+  std::size_t boundary = 0;  ///< index in Problem::boundaries (for messages)
+  bool reached = false;      ///< as PressureConstraint::reached
 };
 
 /// Every constraint of a run.
@@ -280,9 +285,9 @@ Constraints compile_constraints(const Problem& problem, const GridState<Dim>& gr
     }
     if (b.rigid[0] || b.rigid[1] || b.rigid[2])
       c.rigid_ties.push_back({nodes, b.rigid, {0.0, 0.0, 0.0}, bi});
-    if (b.seepage && fluid) c.seepage.push_back({nodes});
+    if (b.seepage && fluid) c.seepage.push_back({nodes, bi, false});
     if (b.pore_pressure && fluid) {
-      PressureConstraint pc{std::move(nodes), &*b.pore_pressure, nullptr, {}};
+      PressureConstraint pc{std::move(nodes), &*b.pore_pressure, nullptr, {}, bi, false};
       if (b.pore_pressure_field) {
         pc.field = &b.pore_pressure_field;
         for (std::int64_t i : pc.nodes) pc.x.push_back(detail::node_position3(grid, i));

@@ -147,9 +147,16 @@ inline void for_face_nodes(const FaceParticles& face, std::size_t k,
 /// Surface loads at time t, mapped at the loaded face of each selected
 /// particle and added to the nodal force (for_face_nodes; DeadLoad: the
 /// quasi-static scheme, whose Terzaghi and Mandel loads are fixed forces).
-template <int Dim, class Shape, bool DeadLoad = false>
+/// Only nodes that carry the soil take load (`takes(node)`: nodes with
+/// mass): a face inside the grid, whose GIMP or B-spline stencil reaches a
+/// node above the soil, gives that node's share to the others (before, it
+/// was lost: half_length / 4 of the load with GIMP, 12.5 % at one particle
+/// per cell, issue 38). Where every node takes load the weights are used
+/// as they are.
+template <int Dim, class Shape, bool DeadLoad = false, class Takes>
 inline void apply_tractions(const std::vector<TractionLoad>& tractions,
-                            const ParticleState<Dim>& particles, GridState<Dim>& grid, double t) {
+                            const ParticleState<Dim>& particles, GridState<Dim>& grid, double t,
+                            Takes&& takes) {
   using Vec = VecD<Dim>;
   shape::Stencil<Dim, Shape> s;
   for (const TractionLoad& load : tractions) {
@@ -163,9 +170,25 @@ inline void apply_tractions(const std::vector<TractionLoad>& tractions,
         for (int a = 0; a < Dim; ++a)
           if (load.source->traction_field[a])
             traction[a] = load.source->traction_field[a](load.x0[k], t);
-      for_face_nodes<Dim, Shape, DeadLoad>(
-          load, k, particles, grid, s,
-          [&](std::int64_t node, double wa) { grid.force[node] += wa * traction; });
+      double all = 0.0, kept = 0.0;
+      for_face_nodes<Dim, Shape, DeadLoad>(load, k, particles, grid, s,
+                                           [&](std::int64_t node, double wa) {
+                                             all += wa;
+                                             if (takes(node)) kept += wa;
+                                           });
+      if (!(kept > 0.0)) continue;
+      if (kept == all) {
+        for_face_nodes<Dim, Shape, DeadLoad>(
+            load, k, particles, grid, s,
+            [&](std::int64_t node, double wa) { grid.force[node] += wa * traction; });
+        continue;
+      }
+      const double scale = all / kept;
+      for_face_nodes<Dim, Shape, DeadLoad>(load, k, particles, grid, s,
+                                           [&](std::int64_t node, double wa) {
+                                             if (takes(node))
+                                               grid.force[node] += (wa * scale) * traction;
+                                           });
     }
   }
 }

@@ -169,7 +169,8 @@ inline void map_particles_to_grid_by_rows(StepContext<Dim, Shape>& ctx, const Sc
 /// Surface loads at time t (boundary/tractions.hpp) added to the nodal force.
 template <int Dim, class Shape>
 inline void apply_surface_loads(StepContext<Dim, Shape>& ctx, double t) {
-  apply_tractions<Dim, Shape>(ctx.model.tractions, ctx.particles, ctx.grid, t);
+  apply_tractions<Dim, Shape>(ctx.model.tractions, ctx.particles, ctx.grid, t,
+                              [&ctx](std::int64_t i) { return ctx.grid.mass[i] > 0.0; });
 }
 
 template <int Dim, class Shape>
@@ -177,6 +178,27 @@ inline void apply_boundary_fluxes(StepContext<Dim, Shape>& ctx, double t) {
   // The nodes with storage: those the saturated particles reach.
   apply_fluxes<Dim, Shape>(ctx.model.fluxes, ctx.particles, ctx.grid, t,
                            [&ctx](std::int64_t i) { return ctx.grid.storage[i] > 0.0; });
+}
+
+/// Surface pressures (boundary/surface_pressures.hpp) at time t into the
+/// nodal flux, with the particles' pressure interpolated from the nodal
+/// field at the start of the step (the explicit scheme; serial: few
+/// particles).
+template <int Dim, class Shape>
+inline void apply_surface_pressure_fluxes(StepContext<Dim, Shape>& ctx, double t) {
+  using StencilT = shape::Stencil<Dim, Shape>;
+  StencilT s;
+  double w[StencilT::N];
+  for_surface_particles<Dim>(
+      ctx.model.surface_pressures, ctx.particles, ctx.model.constants, t,
+      [&](std::size_t p, double c, double p_face, bool seepage, const VecD<Dim>& face) {
+        ctx.template stencil_in_step<false, true>(p, s);
+        double p_bar = 0.0;
+        for (int k = 0; k < StencilT::N; ++k) p_bar += s.w[k] * ctx.grid.pressure[s.node[k]];
+        const double q = surface_inflow(c, p_face, p_bar, seepage);
+        face_weights<Dim, Shape>(s, face, ctx.grid, ctx.particles, p, w);
+        for (int k = 0; k < StencilT::N; ++k) ctx.grid.flux[s.node[k]] += w[k] * q;
+      });
 }
 
 }  // namespace hmpm

@@ -6,16 +6,61 @@
 
 #include <cmath>
 #include <cstdint>
+#include <string>
+#include <vector>
 
 #include "boundary/apply.hpp"
 #include "simulation.hpp"
 
 namespace hmpm {
 
+/// A node condition on the pore water that the soil has left (issue 38):
+/// per pressure or seepage constraint, whether some node of it has soil
+/// (`has_soil(node)`: a saturated particle's stencil reaches it). One that
+/// had soil at an earlier step of the stage and has none now no longer
+/// drains anything: the soil it drained (settled below its nodes, or moved
+/// away) is then undrained, which the rest of the run would report as a
+/// successful run with frozen settlement and suction. The run stops there,
+/// naming the condition and what to use instead (surface_pressures, which
+/// move with the soil).
+template <class HasSoil>
+inline void check_drained_contact(Constraints& constraints, Failures& failures, double t,
+                                  HasSoil&& has_soil) {
+  auto touches = [&](const std::vector<std::int64_t>& nodes) {
+    for (std::int64_t i : nodes)
+      if (has_soil(i)) return true;
+    return false;
+  };
+  auto left = [&](std::size_t boundary, const char* what) {
+    failures.fail_run(
+        "boundaries[" + std::to_string(boundary) + "]." + what +
+            " reaches no soil any more at t = " + number(t) +
+            " s: no saturated particle's shape functions reach its nodes (the soil settled or "
+            "moved away from them), so the soil it drained is undrained from here on and the "
+            "results would be wrong",
+        "pose the drained surface on the soil itself with surface_pressures ({\"particles\": "
+        "..., \"face\": \"y+\", \"pore_pressure\": 0} or \"seepage\": true), which moves "
+        "with the soil wherever it lies in the grid (docs/job-spec.md, where to put drained "
+        "boundaries); or end the condition with a stage when it should lapse");
+  };
+  for (PressureConstraint& c : constraints.pressure) {
+    const bool now = touches(c.nodes);
+    if (c.reached && !now) return left(c.boundary, "pore_pressure");
+    c.reached = c.reached || now;
+  }
+  for (SeepageFace& face : constraints.seepage) {
+    const bool now = touches(face.nodes);
+    if (face.reached && !now) return left(face.boundary, "seepage");
+    face.reached = face.reached || now;
+  }
+}
+
 /// Nodal pressure = storage-weighted average of particle pressures, then
 /// prescribed values at time t.
 template <int Dim, class Shape>
 inline void compute_nodal_pressure(StepContext<Dim, Shape>& ctx, double t) {
+  check_drained_contact(ctx.model.constraints, ctx.failures, t,
+                        [&](std::int64_t i) { return ctx.grid.storage[i] > 0; });
   ctx.for_nodes([&](std::int64_t b, std::int64_t e) {
     for (std::int64_t i = b; i < e; ++i)
       ctx.grid.pressure[i] =

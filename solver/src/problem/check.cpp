@@ -454,6 +454,11 @@ std::vector<ProblemIssue> check_problem(const Problem& problem) {
   for (int a = 0; a < dim; ++a) {
     if (problem.grid.cells[a] < 1)
       add(Location{"grid", "cells"} / static_cast<std::size_t>(a), "must be >= 1");
+    else if (problem.grid.cells[a] < 2 && problem.shape_function != ShapeFunction::linear)
+      // A 3-node stencil spans three node columns: one cell has two (the
+      // stencil's first node fell outside the grid).
+      add(Location{"grid", "cells"} / static_cast<std::size_t>(a),
+          "must be >= 2 with shape_function gimp or bspline (their stencil spans 3 nodes)");
     if (!(problem.grid.max[a] > problem.grid.min[a]))
       add(Location{"grid", "max"} / static_cast<std::size_t>(a), "must be greater than grid.min");
   }
@@ -493,6 +498,10 @@ std::vector<ProblemIssue> check_problem(const Problem& problem) {
     if (problem.fluxes[i].polygon)
       check_selection_polygon(problem, *problem.fluxes[i].polygon,
                               Location{"fluxes"} / i / "particles" / "polygon", issues);
+  for (std::size_t i = 0; i < problem.surface_pressures.size(); ++i)
+    if (problem.surface_pressures[i].polygon)
+      check_selection_polygon(problem, *problem.surface_pressures[i].polygon,
+                              Location{"surface_pressures"} / i / "particles" / "polygon", issues);
   if (issues.size() > before_shapes) return issues;
   check_varying(problem, issues);
   const std::vector<BodyLayout> layouts = body_layouts(problem, LayoutDetail::counts);

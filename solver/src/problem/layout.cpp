@@ -258,6 +258,10 @@ bool particle_selected(const Problem& problem, const Flux& flux, const Vec3& x) 
   return in_selection(problem, flux.particles, flux.polygon, x);
 }
 
+bool particle_selected(const Problem& problem, const SurfacePressure& s, const Vec3& x) {
+  return in_selection(problem, s.particles, s.polygon, x);
+}
+
 bool particle_selected(const Problem& problem, const ConsolidationRequest& c, const Vec3& x) {
   return c.all || in_selection(problem, c.particles, c.polygon, x);
 }

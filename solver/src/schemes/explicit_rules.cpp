@@ -44,6 +44,22 @@ StableStep explicit_stable_step(const Problem& problem) {
   s.mechanical = std::numeric_limits<double>::infinity();
   s.hydraulic = std::numeric_limits<double>::infinity();
   const std::vector<bool> with_particles = materials_with_particles(problem);
+  // Surface pressures (boundary/surface_pressures.hpp): a particle's face
+  // conductance C w_i N_j adds at most 4 C / (Q V) = 8 c_h / l^2 to the
+  // largest eigenvalue of the lumped pressure equation (per node w_i is at
+  // most 4 times the weight of the storage the particle gives it), l the shortest
+  // particle length along a face's normal: the cell over the most particles
+  // per cell, shortened by a fifth for a particle compressed as it settles.
+  double face_length = std::numeric_limits<double>::infinity();
+  if (!problem.surface_pressures.empty()) {
+    int ppc = 1;
+    for (const Body& body : problem.bodies) ppc = std::max(ppc, body.particles_per_cell);
+    for (const SurfacePressure& sp : problem.surface_pressures) {
+      const int a = std::clamp(sp.axis, 0, 2);
+      const double cell = (problem.grid.max[a] - problem.grid.min[a]) / problem.grid.cells[a];
+      face_length = std::min(face_length, 0.8 * cell / ppc);
+    }
+  }
   // Varying parameters at their largest: the stiffest particle's wave and
   // the most conductive particle's diffusion limit the step.
   const std::vector<Material> limiting = limiting_materials(problem);
@@ -58,9 +74,14 @@ StableStep explicit_stable_step(const Problem& problem) {
     s.mechanical = std::min(s.mechanical, h / (c * std::sqrt(d)));
     if (m.hydraulic) {
       // Forward Euler on dp/dt = c_h lap p with lumped storage:
-      // lambda_max = 4 d c_h / h^2, stable for dt <= 2/lambda_max.
+      // lambda_max = 4 d c_h / h^2 (plus the surface pressures' term),
+      // stable for dt <= 2/lambda_max.
       const double c_h = mc.permeability_over_gamma / mc.storage;
-      s.hydraulic = std::min(s.hydraulic, h * h / (2.0 * d * c_h));
+      const double limit =
+          std::isfinite(face_length)
+              ? 2.0 / (4.0 * d * c_h / (h * h) + 8.0 * c_h / (face_length * face_length))
+              : h * h / (2.0 * d * c_h);
+      s.hydraulic = std::min(s.hydraulic, limit);
     }
   }
   s.limit = std::min(s.mechanical, s.hydraulic);
@@ -75,7 +96,10 @@ void check_explicit_step(const Problem& problem, const StableStep& s,
   if (!problem.time.dt || *problem.time.dt <= s.limit * (1.0 + 1e-12)) return;
   auto fmt = [](double v) { return format_significant(v, 4); };
   std::string why = s.hydraulic < s.mechanical
-                        ? "the explicit hydraulic diffusion limit h^2/(2 d k/(gamma_w Q))"
+                        ? "the explicit hydraulic diffusion limit h^2/(2 d k/(gamma_w Q))" +
+                              std::string(problem.surface_pressures.empty()
+                                              ? ""
+                                              : " with the surface pressures' face term")
                         : "the mechanical limit h/(c sqrt(d)) with undrained wave speed c = " +
                               fmt(s.wave_speed) + " m/s";
   issues.push_back({{"time", "dt"},

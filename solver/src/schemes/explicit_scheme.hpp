@@ -51,6 +51,7 @@ class ExplicitScheme final : public TimeScheme {
     update_particle_stress_and_fluid_flux(dt);
     if (c_.model.fluid) {
       hmpm::apply_boundary_fluxes(c_, t);
+      if (!c_.model.surface_pressures.empty()) hmpm::apply_surface_pressure_fluxes(c_, t);
       hmpm::update_nodal_pressure(c_, t + dt, dt);
       update_particle_pressure_and_position(dt);
     }

@@ -93,6 +93,7 @@
 #include "linear/up_system.hpp"
 #include "materials/material.hpp"
 #include "objective_rate.hpp"
+#include "phases/pore_pressure.hpp"
 #include "schemes/quasi_static_plan.hpp"
 #include "schemes/time_scheme.hpp"
 #include "simulation.hpp"
@@ -409,7 +410,14 @@ class QuasiStaticScheme final : public TimeScheme {
   /// Newton iterations for the step t -> t + h. True when converged (the
   /// particles are then updated); false otherwise, with nothing changed.
   bool attempt(double t, double h) {
-    if (!prepared_) prepare();
+    if (!prepared_) {
+      prepare();
+      if (c_.model.fluid)
+        check_drained_contact(c_.model.constraints, c_.failures, t, [this](std::int64_t i) {
+          return weight_fluid_[static_cast<std::size_t>(i)] > tiny_;
+        });
+      if (c_.failures.failed) return false;
+    }
     auto& grid = c_.grid;
     const auto nodes = static_cast<std::size_t>(grid.count);
     // Prescribed values and the initial guess (du = 0, p = p^n).
@@ -439,6 +447,13 @@ class QuasiStaticScheme final : public TimeScheme {
           c_.model.fluxes, c_.particles, grid, t + h,
           [this](std::int64_t i) { return weight_fluid_[static_cast<std::size_t>(i)] > tiny_; });
     }
+    // Surface pressures at t + h (boundary/surface_pressures.hpp).
+    surface_.clear();
+    for_surface_particles<Dim>(
+        c_.model.surface_pressures, c_.particles, c_.model.constants, t + h,
+        [&](std::size_t p, double cond, double p_face, bool seepage, const Vec& face) {
+          surface_.push_back({p, cond, p_face, seepage, face});
+        });
     const ImplicitControl& c = c_.model.problem.time.implicit;
     history_.resize(static_cast<std::size_t>(c.max_iterations) + 1);  // no-op after the first
     for (int it = 0;; ++it) {
@@ -491,7 +506,9 @@ class QuasiStaticScheme final : public TimeScheme {
   /// load by the top particle's strain; Terzaghi's and Mandel's loads are
   /// fixed forces).
   void apply_dead_loads(double t) {
-    apply_tractions<Dim, Shape, /*DeadLoad=*/true>(c_.model.tractions, c_.particles, c_.grid, t);
+    apply_tractions<Dim, Shape, /*DeadLoad=*/true>(
+        c_.model.tractions, c_.particles, c_.grid, t,
+        [this](std::int64_t i) { return weight_[static_cast<std::size_t>(i)] > tiny_; });
   }
 
   /// The particle's strain increment and trial-then-returned stress for the
@@ -647,6 +664,30 @@ class QuasiStaticScheme final : public TimeScheme {
         }
         rhs_[di] += r;
         ref_[di] += ra;
+      }
+    }
+    // Surface pressures: the mass balance loses h times each face's
+    // outflow C (p_bar - p_face), at the face's weights (a seepage
+    // face only while p_bar > 0: a semi-smooth Newton step).
+    for (const SurfaceParticle& sp : surface_) {
+      StencilT s;
+      c_.template stencil_in_step<false, true>(sp.p, s);
+      double p_bar = 0.0;
+      for (int k = 0; k < N; ++k) p_bar += s.w[k] * p_[static_cast<std::size_t>(s.node[k])];
+      if (sp.seepage && !(p_bar > 0.0)) continue;
+      const double out = h * sp.c * (p_bar - sp.p_face);
+      double w[N];
+      face_weights<Dim, Shape>(s, sp.face, c_.grid, c_.particles, sp.p, w);
+      for (int k = 0; k < N; ++k) {
+        const std::int64_t dk = pdof_[static_cast<std::size_t>(s.node[k])];
+        if (dk < 0) continue;
+        rhs_[dk] += w[k] * out;
+        ref_[dk] += std::abs(w[k] * out);
+        if (!jacobian) continue;
+        for (int l = 0; l < N; ++l) {
+          const std::int64_t dl = pdof_[static_cast<std::size_t>(s.node[l])];
+          if (dl >= 0) system_.add(dk, dl, -e_ref_ * h * sp.c * w[k] * s.w[l]);
+        }
       }
     }
     // Convergence: each block's residual against the size of its terms.
@@ -967,7 +1008,15 @@ class QuasiStaticScheme final : public TimeScheme {
   double tiny_ = 0.0;
   bool prepared_ = false;
   std::vector<std::int64_t> seepage_;  ///< seepage face nodes
-  std::vector<std::uint8_t> held_;     ///< per node: a face node held at p = 0 this step
+  /// A particle a surface pressure selects, in the step being attempted.
+  struct SurfaceParticle {
+    std::size_t p;
+    double c, p_face;  ///< conductance, face pressure at t + h
+    bool seepage;
+    Vec face;  ///< the face's centre
+  };
+  std::vector<SurfaceParticle> surface_;
+  std::vector<std::uint8_t> held_;  ///< per node: a face node held at p = 0 this step
   std::int64_t unknowns_ = 0;
 
   std::vector<double> weight_, weight_fluid_, pn_, du_, p_;

@@ -165,6 +165,7 @@ class SemiImplicitScheme final : public TimeScheme {
       for (std::int64_t i = b; i < e; ++i) grid.remap[i].setZero();
     });
     assemble_laplacian(dt);
+    add_surface_pressures(t + dt);
     std::fill(grid.dp.begin(), grid.dp.end(), 0.0);
     apply_pressure_increment_constraints(c_.model.constraints, grid, t + dt);
     // Seepage faces: an active set. Every face node starts free (no water
@@ -185,6 +186,23 @@ class SemiImplicitScheme final : public TimeScheme {
       if (!changed) break;
       ok = solve_once();
     }
+    // Seepage faces of particles (surface_pressures): an active set too. A
+    // face lets water out while the pressure at its particle is positive;
+    // one that would take water in leaves the system, one whose particle
+    // rises above zero joins it, until none changes.
+    for (std::size_t round = 0; ok && round <= surface_.size(); ++round) {
+      bool changed = false;
+      for (SurfaceParticle& sp : surface_) {
+        if (!sp.seepage) continue;
+        const bool out = sp.p_bar + interpolate(sp.p, grid.dp) > 0.0;
+        if (out == sp.active) continue;
+        sp.active = out;
+        add_surface_term(sp, out ? 1.0 : -1.0);
+        changed = true;
+      }
+      if (!changed) break;
+      ok = solve_once();
+    }
     for (std::int64_t i : seepage_) prescribed_[static_cast<std::size_t>(i)] = 0;
     // The coupling boxes and activity flags, cleared for the next step.
     for (std::size_t u = 0; u < active_.size(); ++u) {
@@ -193,6 +211,64 @@ class SemiImplicitScheme final : public TimeScheme {
       std::fill(box_.data() + u * Box::size, box_.data() + (u + 1) * Box::size, 0.0);
     }
     return ok;
+  }
+
+  /// A particle a surface pressure selects (boundary/surface_pressures.hpp):
+  /// its conductance, face pressure, pressure p^n at the particle, and
+  /// whether its terms are in the system.
+  struct SurfaceParticle {
+    std::size_t p = 0;
+    double c = 0.0, p_face = 0.0, p_bar = 0.0;
+    VecD<Dim> face = VecD<Dim>::Zero();
+    bool seepage = false, active = false;
+  };
+
+  /// sum N_i f_i at particle p.
+  double interpolate(std::size_t p, const std::vector<double>& f) const {
+    typename Context::StencilT s;
+    c_.template stencil_in_step<false, true>(p, s);
+    double v = 0.0;
+    for (int k = 0; k < Context::StencilT::N; ++k)
+      v += s.w[k] * f[static_cast<std::size_t>(s.node[k])];
+    return v;
+  }
+
+  /// Surface pressures at t + dt (boundary/surface_pressures.hpp): the
+  /// exchange C w (p_face - p_bar^n) into the right-hand side (as flux)
+  /// and C dt N N^T into the couplings (implicit in the increment, zero at
+  /// steady state); seepage faces start active where p_bar^n > 0.
+  void add_surface_pressures(double t) {
+    surface_.clear();
+    if (c_.model.surface_pressures.empty()) return;
+    for_surface_particles<Dim>(
+        c_.model.surface_pressures, c_.particles, c_.model.constants, t,
+        [&](std::size_t p, double c, double p_face, bool seepage, const Vec& face) {
+          SurfaceParticle sp{p, c, p_face, 0.0, face, seepage, false};
+          sp.p_bar = interpolate(p, c_.grid.pressure);
+          sp.active = !seepage || sp.p_bar > 0.0;
+          if (sp.active) add_surface_term(sp, 1.0);
+          surface_.push_back(sp);
+        });
+  }
+
+  /// Adds (sign 1) or takes out (-1) a surface particle's terms.
+  void add_surface_term(const SurfaceParticle& sp, double sign) {
+    static constexpr auto offsets = Box::offsets();
+    typename Context::StencilT s;
+    c_.template stencil_in_step<false, true>(sp.p, s);
+    const double q = sign * sp.c * (sp.p_face - sp.p_bar), cdt = sign * sp.c * dt_;
+    double w[Context::StencilT::N];
+    face_weights<Dim, Shape>(s, sp.face, c_.grid, c_.particles, sp.p, w);
+    for (int k = 0; k < Context::StencilT::N; ++k) {
+      const std::int64_t i = s.node[k];
+      const auto u = static_cast<std::size_t>(i);
+      active_[u] = 1;
+      c_.grid.flux[u] += w[k] * q;
+      double* const row = box_.data() + u * Box::size;
+      const auto& off = offsets[static_cast<std::size_t>(k)];
+      for (int l = 0; l < Context::StencilT::N; ++l)
+        if (s.node[l] >= i) row[off[static_cast<std::size_t>(l)]] += cdt * s.w[k] * s.w[l];
+    }
   }
 
   /// Numbers the unknowns (active free nodes), assembles the system from
@@ -424,8 +500,9 @@ class SemiImplicitScheme final : public TimeScheme {
   std::vector<int> unknown_;
   std::vector<std::int64_t> node_of_;
   std::vector<double> rhs_, x_, last_dp_;
-  std::vector<std::int64_t> seepage_;  ///< seepage face nodes (an active set each step)
-  double dt_ = 0.0;                    ///< the step's length, for solve_once
+  std::vector<std::int64_t> seepage_;     ///< seepage face nodes (an active set each step)
+  std::vector<SurfaceParticle> surface_;  ///< the step's surface-pressure particles
+  double dt_ = 0.0;                       ///< the step's length, for solve_once
   std::array<std::int64_t, Box::size> node_offset_{};
   struct Band {
     std::int64_t first = 0;            ///< its lowest node
