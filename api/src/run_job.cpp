@@ -28,6 +28,7 @@ JobOutcome run_job(const ParsedJob& job, const fs::path& out_dir, const hmpm::Ru
   JobOutcome outcome;
   std::vector<std::pair<double, std::string>> snapshots;
   std::string write_error;
+  bool mechanism = false;  // mechanism.vtu written (strength reduction)
   if (options.resume) {
     try {  // the snapshots the interrupted run wrote before its checkpoint
       const CheckpointInfo info =
@@ -42,6 +43,17 @@ JobOutcome run_job(const ParsedJob& job, const fs::path& out_dir, const hmpm::Ru
   std::vector<std::string> material_names;
   for (const Material& m : job.problem.materials) material_names.push_back(m.name);
   opts.on_snapshot = [&](const Snapshot& s) {
+    if (s.mechanism) {  // a strength reduction's failure mechanism, not in the .pvd
+      try {
+        write_snapshot_vtu(out_dir / "mechanism.vtu", s, material_names);
+        mechanism = true;
+      } catch (const std::exception& e) {
+        write_error = e.what();
+        throw;
+      }
+      if (options.on_snapshot) options.on_snapshot(s);
+      return;
+    }
     const std::string name = snapshot_file_name(s.index);
     try {
       write_snapshot_vtu(out_dir / name, s, material_names);
@@ -65,6 +77,7 @@ JobOutcome run_job(const ParsedJob& job, const fs::path& out_dir, const hmpm::Ru
 
   for (const auto& [time, name] : snapshots) outcome.files.push_back(name);
   if (!snapshots.empty()) outcome.files.push_back("snapshots.pvd");
+  if (mechanism) outcome.files.push_back("mechanism.vtu");
   const OutputRequest& out = job.problem.output;
   const bool series_requested = !out.series_particles.empty() && !out.series_fields.empty();
   // A pair of files (`stem`.json and `stem`.csv) of a history kept in memory.

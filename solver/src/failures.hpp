@@ -31,6 +31,9 @@ struct Failures {
   /// whether set-up reported warnings.
   double stable_limit = 0.0;
   bool warned = false;
+  /// The first collapse found (time.on_collapse): a scheme's or the time
+  /// loop's finding, written between phases.
+  RunResult::Collapse collapse;
 
   void record(std::size_t p, std::string text, std::string advice) {
     std::lock_guard<std::mutex> lock(mutex);

@@ -246,6 +246,11 @@ class Simulation {
   /// Stage::reset_displacement: x0 = x, strain zero.
   void reset_displacement();
 
+  // ------------------------------------------------------------ after the stages
+  /// Problem::strength_reduction from the state at time t
+  /// (strength_reduction.hpp): the factor of safety into `result`.
+  void reduce_strength(RunResult& result, double t, const RunOptions& options);
+
   // ------------------------------------------------------------ output (output.hpp)
   void fill_snapshot(Snapshot& snap, const std::vector<Field>& fields) const;
   void sample_series(Series& series, double t) const;

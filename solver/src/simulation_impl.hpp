@@ -16,4 +16,5 @@
 #include "setup.hpp"
 #include "simulation.hpp"
 #include "stages.hpp"
+#include "strength_reduction.hpp"
 #include "time_loop.hpp"

@@ -461,11 +461,30 @@ RunResult Simulation<Dim, Shape>::run(const RunOptions& options) {
         "set output.consolidation.from to the end of the loading (a load applied at t = 0 "
         "builds its excess in the first step), and steady_pore_pressure to the pore pressure "
         "the ground drains to (hydrostatic under gravity)");
+  result.iterations = done_iterations;
+  // The factor of safety, from the state the stages reached
+  // (strength_reduction.hpp), and the mechanism as the last snapshot.
+  if (result.status == RunStatus::successful && job_.strength_reduction) {
+    reduce_strength(result, t, options);
+    if (failures_.failed) {
+      result.status = RunStatus::failed;
+      result.message = "strength reduction after t = " + number(t) + " s: " + failures_.what +
+                       ". What to change: " + failures_.hint + ".";
+    } else if (result.status == RunStatus::successful && options.on_snapshot) {
+      snap.time = t;
+      snap.mechanism = true;
+      fill_snapshot(snap, snapshot_fields);
+      options.on_snapshot(snap);
+    }
+  }
+  result.collapse = failures_.collapse;
+  if (result.collapse.found && !result.collapse.stopped)
+    result.run_warnings.push_back(result.collapse.message +
+                                  "; the run went on (time.on_collapse 'continue')");
   const double seconds =
       seconds_before + std::chrono::duration<double>(Clock::now() - start).count();
   result.warnings.insert(result.warnings.end(), result.run_warnings.begin(),
                          result.run_warnings.end());
-  result.iterations = done_iterations;
   result.steps = n;
   result.end_time = t;
   result.solve_seconds = seconds;
@@ -474,6 +493,8 @@ RunResult Simulation<Dim, Shape>::run(const RunOptions& options) {
   if (result.status == RunStatus::successful) {
     result.message = "completed " + std::to_string(n) + " steps to t = " + number(t) + " s";
     if (stages > 1) result.message.append(" in ").append(std::to_string(stages)).append(" stages");
+    if (result.strength_reduction.done)
+      result.message.append("; ").append(result.strength_reduction.message);
   }
   report(n, t);
   return result;

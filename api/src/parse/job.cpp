@@ -17,11 +17,11 @@ namespace parse {
 namespace {
 
 constexpr std::string_view top_allowed[] = {
-    "name",           "description",      "dimension",     "grid",
-    "shape_function", "materials",        "bodies",        "gravity",
-    "boundaries",     "tractions",        "time",          "output",
-    "local_damping",  "gravity_constant", "initial_state", "fluxes",
-    "stages"};
+    "name",           "description",       "dimension",     "grid",
+    "shape_function", "materials",         "bodies",        "gravity",
+    "boundaries",     "tractions",         "time",          "output",
+    "local_damping",  "gravity_constant",  "initial_state", "fluxes",
+    "stages",         "strength_reduction"};
 constexpr std::string_view top_required[] = {"dimension", "grid", "materials", "bodies", "time"};
 // At most this many errors are reported (then one line counting the rest).
 constexpr std::size_t max_errors = 1000;
@@ -107,6 +107,8 @@ void read_root(ParseContext& c, const json& root) {
     read_initial_state(c, root["initial_state"], "/initial_state");
   if (root.contains("output")) read_output(c, root["output"], "/output");
   if (root.contains("stages")) read_stages(c, root["stages"], "/stages");  // after the lists
+  if (root.contains("strength_reduction"))
+    read_strength_reduction(c, root["strength_reduction"], "/strength_reduction");
 
   if (c.any_pore_pressure_bc &&
       std::none_of(c.p.materials.begin(), c.p.materials.end(),
@@ -171,6 +173,7 @@ const std::vector<SpecObjectKeys>& spec_object_keys() {
     parse::flux_keys(t);
     parse::initial_state_keys(t);
     parse::time_keys(t);
+    parse::strength_reduction_keys(t);
     parse::output_keys(t);
     parse::stage_keys(t);
     return t;

@@ -114,6 +114,7 @@ void read_boundaries(ParseContext& c, const json& j, const std::string& path);
 void read_tractions(ParseContext& c, const json& j, const std::string& path);
 void read_fluxes(ParseContext& c, const json& j, const std::string& path);
 void read_time(ParseContext& c, const json& j, const std::string& path);
+void read_strength_reduction(ParseContext& c, const json& j, const std::string& path);
 void read_local_damping(ParseContext& c, const json& j, const std::string& path);
 void read_initial_state(ParseContext& c, const json& j, const std::string& path);
 void read_output(ParseContext& c, const json& j, const std::string& path);
@@ -205,6 +206,7 @@ void traction_keys(std::vector<SpecObjectKeys>& out);
 void flux_keys(std::vector<SpecObjectKeys>& out);
 void initial_state_keys(std::vector<SpecObjectKeys>& out);
 void time_keys(std::vector<SpecObjectKeys>& out);
+void strength_reduction_keys(std::vector<SpecObjectKeys>& out);
 void output_keys(std::vector<SpecObjectKeys>& out);
 void stage_keys(std::vector<SpecObjectKeys>& out);
 /// The values of the spec's enumerations: output field names (from

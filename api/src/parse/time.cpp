@@ -9,7 +9,8 @@
 namespace hmpm::api::parse {
 namespace {
 
-constexpr std::string_view time_allowed[] = {"end", "scheme", "dt", "courant", "implicit"};
+constexpr std::string_view time_allowed[] = {"end",     "scheme",   "dt",
+                                             "courant", "implicit", "on_collapse"};
 constexpr std::string_view time_required[] = {"end"};
 constexpr std::string_view growth_allowed[] = {"initial", "max", "growth"};
 constexpr std::string_view implicit_allowed[] = {"tolerance", "max_iterations", "max_cutbacks",
@@ -17,6 +18,8 @@ constexpr std::string_view implicit_allowed[] = {"tolerance", "max_iterations", 
 // In the order of hmpm::Scheme and hmpm::LinearSolver.
 constexpr std::string_view schemes[] = {"explicit", "semi_implicit", "quasi_static"};
 constexpr std::string_view linear_solvers[] = {"auto", "direct", "iterative"};
+// In the order of hmpm::CollapseAction.
+constexpr std::string_view collapse_actions[] = {"stop", "continue"};
 
 constexpr double inf = std::numeric_limits<double>::infinity();
 
@@ -112,6 +115,9 @@ void read_time(ParseContext& c, const json& j, const std::string& path) {
   if (j.contains("dt")) read_dt(c, j["dt"], path + "/dt");
   c.r.number_at(j, path, "courant", {0.0, 1.0, true, false}, c.p.time.courant);
   if (j.contains("implicit")) read_implicit(c, j["implicit"], path + "/implicit");
+  if (j.contains("on_collapse"))
+    if (auto s = c.r.one_of(j["on_collapse"], path + "/on_collapse", collapse_actions))
+      c.p.time.on_collapse = *enum_of<CollapseAction>(*s, collapse_actions);
 }
 
 void read_local_damping(ParseContext& c, const json& j, const std::string& path) {

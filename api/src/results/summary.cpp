@@ -24,6 +24,27 @@ void write_summary(const std::filesystem::path& path, const std::string& job_nam
                        {"cutbacks", it.cutbacks},
                        {"max_nonlinear", it.max_nonlinear}};
   }
+  if (run.collapse.found) {
+    const RunResult::Collapse& k = run.collapse;
+    o["collapse"] = {{"time", k.time},
+                     {"criterion", k.criterion},
+                     {"load", k.load},
+                     {"max_displacement", k.max_displacement},
+                     {"yielding_particles", k.yielding},
+                     {"yielding_min", k.yield_min},
+                     {"yielding_max", k.yield_max},
+                     {"stopped", k.stopped},
+                     {"message", k.message}};
+  }
+  if (run.strength_reduction.done) {
+    const RunResult::StrengthReductionResult& sr = run.strength_reduction;
+    o["strength_reduction"] = {{"factor_of_safety", sr.factor},
+                               {"failed_at", sr.failed_at},  // null: not failed by max_factor
+                               {"factors", sr.factors},
+                               {"max_displacement", sr.max_displacement},
+                               {"attempts", sr.attempts},
+                               {"message", sr.message}};
+  }
   o["particles"] = run.particles;
   o["nodes"] = run.nodes;
   o["solve_seconds"] = run.solve_seconds;

@@ -359,6 +359,11 @@ struct ImplicitControl {
   bool elastic_tangent = false;
 };
 
+/// What a run does when it finds the soil collapsing (time.on_collapse;
+/// docs/job-spec.md "Collapse"): stop there (the run fails with a message
+/// saying where and at what load), or report it and go on.
+enum class CollapseAction { stop, go_on };
+
 struct TimeControl {
   double end = 1.0;  ///< s, required
   /// s; the time the stage in force starts at (stage_problem sets it; 0 for
@@ -370,6 +375,29 @@ struct TimeControl {
   std::optional<StepGrowth> growth;
   double courant = 0.5;  ///< factor on the stable step when dt is automatic
   ImplicitControl implicit;
+  /// Absent: stop in the quasi-static scheme (it cannot go past a limit
+  /// load), go on in the dynamic schemes (a run-out is what they follow).
+  std::optional<CollapseAction> on_collapse;
+};
+
+/// The action a run takes at a collapse: time.on_collapse, or the scheme's default.
+inline CollapseAction collapse_action(const TimeControl& t) {
+  if (t.on_collapse) return *t.on_collapse;
+  return t.scheme == Scheme::quasi_static ? CollapseAction::stop : CollapseAction::go_on;
+}
+
+/// Factor of safety by strength reduction (quasi-static scheme; the job's
+/// `strength_reduction`): after the last stage, the strength of every
+/// Mohr-Coulomb and Drucker-Prager material is divided by F, c / F and
+/// tan(phi) / F (the dilatancy angle kept at most the reduced friction
+/// angle), F raised from 1 in steps of `increment` from the converged state
+/// at the previous F, a step that does not converge halved until it is
+/// below `resolution`. The factor of safety is the largest F that
+/// converged (docs/job-spec.md "Strength reduction").
+struct StrengthReduction {
+  double increment = 0.1;     ///< first step of F
+  double resolution = 0.005;  ///< F is bracketed to within this
+  double max_factor = 10.0;   ///< F is not raised above this (the result is then "at least")
 };
 
 /// The contract name of a scheme ("explicit", "semi_implicit", "quasi_static"):
@@ -475,6 +503,8 @@ struct Problem {
   /// during each.
   std::vector<Stage> stages;
   std::string first_stage_name = "initial";  ///< the top level's stage name
+  /// After the last stage: the factor of safety by strength reduction.
+  std::optional<StrengthReduction> strength_reduction;
 };
 
 /// The time the whole job ends: the last stage's end (stages end in

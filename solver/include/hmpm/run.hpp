@@ -160,6 +160,11 @@ struct Progress {
 struct Snapshot {
   int index = 0;  ///< 0, 1, 2, ... in time order
   double time = 0.0;
+  /// The failure mechanism of a strength reduction (Problem::strength_reduction:
+  /// displacement and plastic strain since F = 1 at the largest F that
+  /// converged), not one of the time series; `index` is then that of the
+  /// next snapshot of the series, unused.
+  bool mechanism = false;
   int dimension = 1;
   std::int64_t particles = 0;
   std::vector<Field> fields;             ///< which of the arrays below are filled
@@ -326,6 +331,35 @@ struct RunResult {
     double t50 = std::numeric_limits<double>::quiet_NaN();
     double t90 = std::numeric_limits<double>::quiet_NaN();
   } consolidation;
+  /// The soil found collapsing (time.on_collapse; docs/job-spec.md
+  /// "Collapse"): the first time it was, what showed it and where.
+  struct Collapse {
+    bool found = false;
+    double time = 0.0;      ///< s: the last state in equilibrium (quasi-static), or when found
+    std::string criterion;  ///< what showed it (the contract's words, docs/job-spec.md)
+    /// The resultant of the surface loads (tractions) at `time`, N (per
+    /// metre in 2D): the load level of a load-controlled run.
+    Vec3 load{0.0, 0.0, 0.0};
+    /// The particles yielding at the collapse (plastic in the last
+    /// iteration or step): how many, and their bounding box.
+    std::int64_t yielding = 0;
+    Vec3 yield_min{0.0, 0.0, 0.0}, yield_max{0.0, 0.0, 0.0};
+    double max_displacement = 0.0;  ///< m, the largest particle displacement
+    bool stopped = false;           ///< the run stopped there (CollapseAction::stop)
+    std::string message;            ///< the sentence of the log and the status
+  } collapse;
+  /// Problem::strength_reduction: the factor of safety.
+  struct StrengthReductionResult {
+    bool done = false;
+    double factor = 0.0;  ///< the largest F that converged
+    /// The first F that did not converge (factor + at most the resolution);
+    /// NaN when F reached max_factor without failing.
+    double failed_at = std::numeric_limits<double>::quiet_NaN();
+    std::vector<double> factors;           ///< every converged F, in order
+    std::vector<double> max_displacement;  ///< m, since F = 1, at each of `factors`
+    std::int64_t attempts = 0;             ///< trial values of F solved (converged or not)
+    std::string message;
+  } strength_reduction;
 };
 
 /// Runs `problem` to its end time. See the file comment for failure modes.

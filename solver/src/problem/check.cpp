@@ -505,6 +505,25 @@ std::vector<ProblemIssue> check_problem(const Problem& problem) {
   for (ProblemIssue& issue : check_geostatic(adds ? initial_ground(problem) : problem))
     issues.push_back(std::move(issue));
   check_stages(problem, issues);
+  if (const auto& sr = problem.strength_reduction) {
+    const Problem last = stage_problem(problem, stage_count(problem) - 1);
+    if (last.time.scheme != Scheme::quasi_static)
+      add({"strength_reduction"},
+          std::string("needs the quasi-static scheme in the last stage (its Newton iterations "
+                      "find the equilibrium at each reduced strength); the last stage runs '") +
+              scheme_name(last.time.scheme) +
+              "': set its time.scheme to 'quasi_static' (a gravity stage in any scheme may "
+              "come before it)");
+    if (!std::any_of(last.materials.begin(), last.materials.end(), [](const Material& m) {
+          return !std::holds_alternative<LinearElastic>(m.plasticity);
+        }))
+      add({"strength_reduction"},
+          "needs a material with a strength (mohr_coulomb or drucker_prager): elastic soil "
+          "never fails");
+    if (!(sr->increment > 0)) add({"strength_reduction", "increment"}, "must be > 0");
+    if (!(sr->resolution > 0)) add({"strength_reduction", "resolution"}, "must be > 0");
+    if (!(sr->max_factor > 1)) add({"strength_reduction", "max_factor"}, "must be > 1");
+  }
   return issues;
 }
 

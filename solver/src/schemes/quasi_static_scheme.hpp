@@ -57,6 +57,25 @@
 // A step whose Newton iterations do not converge within max_iterations is
 // halved and retried, up to max_cutbacks halvings; then the run fails with
 // the residual reached and what to change.
+//
+// Collapse (time.on_collapse; docs/job-spec.md "Collapse"). In a run with
+// plastic soil, the last halving failing means the loads at the end of the
+// step have no equilibrium state the soil can carry that the Newton
+// iterations can reach from the last one: past a limit load the tangent
+// stiffness is singular and no step, however short, converges. The run
+// then reports a collapse at the last converged time (its load, the
+// particles that yielded in the last converged step, the largest
+// displacement). A run that crawls towards a limit load (each step
+// converging only after cut-backs, as a wall whose head keeps moving
+// does) spends cut-backs without a step converging at its first length in
+// between: 4 max_cutbacks of them in a row is a collapse as well (stop, or
+// a warning and the run goes on).
+//
+// Strength reduction (strength_reduce(), Problem::strength_reduction):
+// the same Newton iterations with reduced material constants, the loads
+// held at their values at the job's end, no prescribed increments and the
+// pore pressures held at their projection (drained strength with the pore
+// pressures of the state reached).
 #pragma once
 
 #include <Eigen/Core>
@@ -101,6 +120,7 @@ class QuasiStaticScheme final : public TimeScheme {
     for (const SeepageFace& face : c_.model.constraints.seepage)
       seepage_.insert(seepage_.end(), face.nodes.begin(), face.nodes.end());
     held_.assign(static_cast<std::size_t>(c_.grid.count), 0);
+    yielded_.assign(c_.particles.size(), 0);
   }
 
   StableStep stable_step(const Problem& problem) const override {
@@ -143,6 +163,10 @@ class QuasiStaticScheme final : public TimeScheme {
         continue;
       }
       if (c_.failures.failed) return;
+      if (cuts >= c.max_cutbacks && c_.model.plastic) {
+        collapse(t_cur, "no_convergence", cuts, hh);
+        return;
+      }
       if (cuts >= c.max_cutbacks) {
         std::ostringstream what;
         what << "the quasi-static Newton iterations did not converge in " << c.max_iterations
@@ -159,9 +183,37 @@ class QuasiStaticScheme final : public TimeScheme {
       ++cuts;
       ++cutbacks_;
       h = 0.5 * hh;
+      // A crawl: cut-backs in a row without a step that converged at its
+      // first length (in this call or a step before).
+      if (++crawl_ >= 4 * std::max(1, c.max_cutbacks) && c_.model.plastic &&
+          !c_.failures.collapse.found) {
+        collapse(t_cur, "cutbacks_in_a_row", crawl_, h);
+        if (c_.failures.failed) return;
+      }
     }
+    if (cuts == 0) crawl_ = 0;
     // After cut-backs the next steps start again from the length that worked.
     if (cuts > 0 && !c_.model.problem.time.dt) nominal_ = std::min(nominal_, h);
+  }
+
+  /// Strength reduction: one attempt to reach equilibrium with the material
+  /// constants `reduced` (kept by reference until the next call), the loads
+  /// at `load_time`. True when it converged (the particles then take the
+  /// state); false with nothing changed.
+  bool strength_reduce(const std::vector<MaterialConstants>& reduced, double load_time) {
+    if (!reducing_) prepared_ = false;  // every pressure is held from now on
+    reducing_ = true;
+    constants_ = &reduced;
+    return attempt(load_time, 1.0);
+  }
+
+  /// The largest particle displacement |x - x0|, m.
+  double max_displacement() const {
+    double m = 0.0;
+    const auto& parts = c_.particles;
+    for (std::size_t p = 0; p < parts.size(); ++p)
+      m = std::max(m, (parts.x[p] - parts.x0[p]).norm());
+    return m;
   }
 
   void report(RunResult& result) const override {
@@ -216,7 +268,7 @@ class QuasiStaticScheme final : public TimeScheme {
       c_.template stencil_in_step<true, false>(p, s);
       const double vol = parts.volume[p];
       vmax = std::max(vmax, vol);
-      const bool sat = c_.model.fluid && c_.model.constants[parts.material[p]].saturated;
+      const bool sat = c_.model.fluid && (*constants_)[parts.material[p]].saturated;
       for (int k = 0; k < N; ++k) {
         weight_[s.node[k]] += s.w[k] * vol;
         if (sat) {
@@ -255,6 +307,7 @@ class QuasiStaticScheme final : public TimeScheme {
       for (std::int64_t i : bc.nodes) pfixed_[static_cast<std::size_t>(i)] = 1;
     for (std::int64_t i : seepage_)
       if (held_[static_cast<std::size_t>(i)]) pfixed_[static_cast<std::size_t>(i)] = 1;
+    if (reducing_) std::fill(pfixed_.begin(), pfixed_.end(), 1);
     for (std::size_t i = 0; i < nodes; ++i) {
       if (!(weight_[i] > tiny_)) continue;
       for (int a = 0; a < Dim; ++a) {
@@ -317,7 +370,7 @@ class QuasiStaticScheme final : public TimeScheme {
     StencilT s;
     for (std::size_t k = b; k < e; ++k) {
       const auto p = static_cast<std::size_t>(keys_[k].second);
-      const MaterialConstants& mc = c_.model.constants[parts.material[p]];
+      const MaterialConstants& mc = (*constants_)[parts.material[p]];
       if (!mc.saturated) continue;
       c_.template stencil_in_step<false, true>(p, s);
       const double v = parts.volume[p];
@@ -358,19 +411,22 @@ class QuasiStaticScheme final : public TimeScheme {
     for (const VelocityConstraint& bc : c_.model.constraints.velocity)
       for (int a = 0; a < Dim; ++a)
         if (bc.fixed[a]) {
-          const double d = 0.5 * ((*bc.fn[a])(t) + (*bc.fn[a])(t + h)) * h;
+          const double d = reducing_ ? 0.0 : 0.5 * ((*bc.fn[a])(t) + (*bc.fn[a])(t + h)) * h;
           for (std::int64_t i : bc.nodes) du_[static_cast<std::size_t>(i) * Dim + a] = d;
         }
     for (std::size_t i = 0; i < nodes; ++i) p_[i] = pn_[i];
-    for (const PressureConstraint& bc : c_.model.constraints.pressure)
-      bc.for_values(t + h, [&](std::int64_t i, double v) { p_[static_cast<std::size_t>(i)] = v; });
-    for (std::int64_t i : seepage_)
-      if (held_[static_cast<std::size_t>(i)]) p_[static_cast<std::size_t>(i)] = 0.0;
+    if (!reducing_) {
+      for (const PressureConstraint& bc : c_.model.constraints.pressure)
+        bc.for_values(t + h,
+                      [&](std::int64_t i, double v) { p_[static_cast<std::size_t>(i)] = v; });
+      for (std::int64_t i : seepage_)
+        if (held_[static_cast<std::size_t>(i)]) p_[static_cast<std::size_t>(i)] = 0.0;
+    }
     // External nodal forces at t + h: tractions (gravity is per particle).
     for (std::size_t i = 0; i < nodes; ++i) grid.force[i].setZero();
-    apply_dead_loads(t + h);
+    apply_dead_loads(reducing_ ? t : t + h);
     // Water across faces at t + h (backward Euler), on the initial face areas.
-    if (!c_.model.fluxes.empty()) {
+    if (!c_.model.fluxes.empty() && !reducing_) {
       std::fill(grid.flux.begin(), grid.flux.end(), 0.0);
       // The nodes the saturated particles reach (free or prescribed).
       apply_fluxes<Dim, Shape, /*DeadLoad=*/true>(
@@ -453,7 +509,7 @@ class QuasiStaticScheme final : public TimeScheme {
       de[4] = 0.5 * (g(1, 2) + g(2, 1));
       de[5] = 0.5 * (g(2, 0) + g(0, 2));
     }
-    const MaterialConstants& mc = c_.model.constants[c_.particles.material[p]];
+    const MaterialConstants& mc = (*constants_)[c_.particles.material[p]];
     sig = c_.particles.stress[p];
     if constexpr (Dim >= 2) rotate_jaumann<Dim>(sig, g, 1.0);
     const double tr = de[0] + de[1] + de[2];
@@ -625,7 +681,7 @@ class QuasiStaticScheme final : public TimeScheme {
     for (std::size_t p = begin; p < end; ++p) {
       c_.template stencil_in_step<true, true>(p, s);
       local_dofs(s, dofs);
-      const MaterialConstants& mc = c_.model.constants[parts.material[p]];
+      const MaterialConstants& mc = (*constants_)[parts.material[p]];
       const bool sat = c_.model.fluid && mc.saturated;
       Mat g;
       Voigt de, sig;
@@ -739,7 +795,7 @@ class QuasiStaticScheme final : public TimeScheme {
       Mat g;
       Voigt de, sig;
       particle_stress(p, s, g, de, sig);
-      const bool sat = c_.model.fluid && c_.model.constants[parts.material[p]].saturated;
+      const bool sat = c_.model.fluid && (*constants_)[parts.material[p]].saturated;
       const double vol = parts.volume[p], m = parts.mass[p];
       const Mat vs = vol * active_stress<Dim>(sig);
       double p_hat = 0.0;
@@ -781,19 +837,20 @@ class QuasiStaticScheme final : public TimeScheme {
       particle_stress(p, s, g, de, sig, nullptr, &plastic);
       parts.stress[p] = sig;
       if (plastic > 0.0) parts.plastic_strain[p] += equivalent_plastic_strain(plastic);
+      yielded_[p] = plastic > 0.0 ? 1 : 0;
       parts.strain[p] += de;
       Mat f = Mat::Identity() + g;
       const double j = f.determinant();
       if (!(j > 0.0)) c_.failures.volume(p, j);
       parts.volume[p] *= j;
-      const MaterialConstants& mc = c_.model.constants[parts.material[p]];
+      const MaterialConstants& mc = (*constants_)[parts.material[p]];
       Vec dx = Vec::Zero();
       for (int k = 0; k < N; ++k) {
         const auto i = static_cast<std::size_t>(s.node[k]);
         for (int a = 0; a < Dim; ++a) dx[a] += s.w[k] * du_[i * Dim + a];
       }
-      if (c_.model.fluid && mc.saturated) {
-        parts.porosity[p] = 1.0 - (1.0 - parts.porosity[p]) / j;
+      if (c_.model.fluid && mc.saturated) parts.porosity[p] = 1.0 - (1.0 - parts.porosity[p]) / j;
+      if (c_.model.fluid && mc.saturated && !reducing_) {
         double p_hat = 0.0;
         Vec grad_p = Vec::Zero();
         for (int k = 0; k < N; ++k) {
@@ -822,7 +879,81 @@ class QuasiStaticScheme final : public TimeScheme {
     }
   }
 
+  /// A collapse at t (the last converged time): the report in the
+  /// failures (the first one), and the run stopped or warned as
+  /// time.on_collapse says. `count` cut-backs, the step down to `h`.
+  void collapse(double t, const char* criterion, std::int64_t count, double h) {
+    RunResult::Collapse found;
+    RunResult::Collapse& k = c_.failures.collapse.found ? found : c_.failures.collapse;
+    k.found = true;
+    k.time = t;
+    k.criterion = criterion;
+    // The load level: the resultant of the surface loads at t.
+    auto& grid = c_.grid;
+    for (std::size_t i = 0; i < static_cast<std::size_t>(grid.count); ++i) grid.force[i].setZero();
+    apply_dead_loads(t);
+    k.load = {0.0, 0.0, 0.0};
+    for (std::size_t i = 0; i < static_cast<std::size_t>(grid.count); ++i)
+      for (int a = 0; a < Dim; ++a) k.load[static_cast<std::size_t>(a)] += grid.force[i][a];
+    // Where it yields: the particles plastic in the last converged step.
+    const auto& parts = c_.particles;
+    k.yielding = 0;
+    for (std::size_t p = 0; p < parts.size() && p < yielded_.size(); ++p) {
+      if (!yielded_[p]) continue;
+      for (int a = 0; a < Dim; ++a) {
+        const auto u = static_cast<std::size_t>(a);
+        k.yield_min[u] = k.yielding ? std::min(k.yield_min[u], parts.x[p][a]) : parts.x[p][a];
+        k.yield_max[u] = k.yielding ? std::max(k.yield_max[u], parts.x[p][a]) : parts.x[p][a];
+      }
+      ++k.yielding;
+    }
+    k.max_displacement = max_displacement();
+    const bool stop = collapse_action(c_.model.problem.time) == CollapseAction::stop;
+    const bool impossible = std::string(criterion) == "no_convergence";
+    k.stopped = stop || impossible;
+    if (&k == &found) c_.failures.collapse.stopped = k.stopped;  // reported before, going on
+    std::ostringstream what;
+    what << "the soil collapses: at t = " << number(t) << " s ";
+    if (impossible)
+      what << "the Newton iterations do not converge even after " << count
+           << " cut-backs (step down to " << number(h) << " s)";
+    else
+      what << count << " cut-backs in a row, none of the steps converging at its first length "
+           << "(step down to " << number(h) << " s)";
+    what << ": a limit load; surface loads " << vector_text(k.load) << " N";
+    if (Dim < 3) what << (Dim == 2 ? "/m" : "/m^2");
+    what << ", largest displacement " << number(k.max_displacement) << " m, " << k.yielding
+         << " particles yielding";
+    if (k.yielding > 0)
+      what << " in " << vector_text(k.yield_min) << " .. " << vector_text(k.yield_max);
+    k.message = what.str();
+    if (k.stopped)
+      c_.failures.fail_run(
+          k.message, impossible && !stop
+                         ? "past a limit load the quasi-static scheme has no state to go on to "
+                           "(time.on_collapse 'continue' cannot apply); lower the loads below the "
+                           "limit, or prescribe a displacement (a velocity) instead of a load to "
+                           "follow the soil past it"
+                         : "lower the loads below the limit, prescribe a displacement (a velocity) "
+                           "instead of a load to follow the soil past it, or set "
+                           "time.on_collapse to 'continue'");
+  }
+
+  /// "(x, y)" of the first Dim components.
+  static std::string vector_text(const Vec3& v) {
+    std::string s = "(";
+    for (int a = 0; a < Dim; ++a) s += (a ? ", " : "") + number(v[static_cast<std::size_t>(a)]);
+    return s + ")";
+  }
+
   Context c_;
+  /// The material constants in force: the model's, or those of a strength
+  /// reduction (strength_reduce()).
+  const std::vector<MaterialConstants>* constants_ = &c_.model.constants;
+  bool reducing_ = false;
+  std::int64_t crawl_ = 0;  ///< cut-backs since a step converged at its first length
+  /// Per particle: plastic in the last converged step (the collapse report).
+  std::vector<std::uint8_t> yielded_;
   StepGrowth growth_;
   double nominal_ = 0.0;
   double e_ref_ = 0.0;

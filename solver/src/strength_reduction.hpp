@@ -1,0 +1,111 @@
+// strength_reduction.hpp — the factor of safety by strength reduction
+// (Problem::strength_reduction; internal).
+//
+// After the last stage (the gravity state, an excavation...), with the
+// loads of the job's end held: the strength of every Mohr-Coulomb and
+// Drucker-Prager material is divided by F,
+//   c_F = c / F,   tan(phi_F) = tan(phi) / F,   psi_F = min(psi, phi_F),
+// the tensile strength by F as well, and the quasi-static scheme looks for
+// equilibrium from the converged state at the previous F
+// (QuasiStaticScheme::strength_reduce: Newton with the consistent tangent,
+// prescribed displacements held, pore pressures held). F starts at 1 and
+// rises by `increment`; a value that does not converge is halved back
+// towards the last converged one (a bisection) until the two are within
+// `resolution`. The failure criterion is non-convergence within
+// time.implicit.max_iterations Newton iterations: with perfectly plastic
+// soil, past the factor of safety no stress field within the reduced
+// strength balances gravity and the loads, so Newton's iterations cannot
+// converge, however close F is to the last converged value (Griffiths &
+// Lane 1999, Geotechnique 49(3), use the same criterion with an iteration
+// ceiling). The displacement since F = 1 is kept at every converged F: it
+// rises steeply towards F (the other criterion of the literature, shown
+// in summary.json). The mechanism (displacement and plastic strain since
+// F = 1 at the largest converged F) is the run's last snapshot.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include "failures.hpp"
+#include "materials/material.hpp"
+#include "schemes/quasi_static_scheme.hpp"
+#include "simulation.hpp"
+#include "time_loop.hpp"
+
+namespace hmpm {
+
+/// The strength of `m` divided by `factor` (c, tan(phi), the tensile
+/// strength; the dilatancy angle at most the reduced friction angle).
+inline Material reduced_strength(Material m, double factor) {
+  constexpr double degree = 3.14159265358979323846 / 180.0;
+  std::visit(
+      [factor](auto& model) {
+        using T = std::decay_t<decltype(model)>;
+        if constexpr (std::is_same_v<T, MohrCoulomb> || std::is_same_v<T, DruckerPrager>) {
+          model.cohesion /= factor;
+          model.tensile_strength /= factor;
+          model.friction_angle_deg =
+              std::atan(std::tan(model.friction_angle_deg * degree) / factor) / degree;
+          model.dilatancy_angle_deg = std::min(model.dilatancy_angle_deg, model.friction_angle_deg);
+        }
+      },
+      m.plasticity);
+  return m;
+}
+
+template <int Dim, class Shape>
+void Simulation<Dim, Shape>::reduce_strength(RunResult& result, double t,
+                                             const RunOptions& options) {
+  const StrengthReduction& sr = *job_.strength_reduction;
+  RunResult::StrengthReductionResult& out = result.strength_reduction;
+  out.done = true;
+  // The mechanism is what the reduction adds: displacement and plastic
+  // strain from here.
+  reset_displacement();
+  std::fill(particles_.plastic_strain.begin(), particles_.plastic_strain.end(), 0.0);
+  QuasiStaticScheme<Dim, Shape> scheme(context());
+  std::vector<MaterialConstants> reduced;
+  double f = 1.0, step = sr.increment;
+  out.factors.push_back(f);
+  out.max_displacement.push_back(0.0);
+  while (f < sr.max_factor) {
+    if (options.cancel && options.cancel->load(std::memory_order_relaxed)) {
+      result.status = RunStatus::cancelled;
+      result.message = "cancelled during the strength reduction at F = " + number(f);
+      return;
+    }
+    const double next = std::min(f + step, sr.max_factor);
+    reduced.clear();
+    for (const Material& m : model_.problem.materials)
+      reduced.push_back(material_constants(reduced_strength(m, next), model_.problem.gravity_constant));
+    ++out.attempts;
+    if (scheme.strength_reduce(reduced, t)) {
+      f = next;
+      out.factors.push_back(f);
+      out.max_displacement.push_back(scheme.max_displacement());
+      continue;
+    }
+    if (failures_.failed) return;  // a particle failed (left the grid...): the run fails
+    out.failed_at = next;
+    if (next - f <= sr.resolution * (1.0 + 1e-9)) break;
+    step = 0.5 * (next - f);
+  }
+  out.factor = f;
+  out.message = std::isnan(out.failed_at)
+                    ? "strength reduction: the soil is in equilibrium up to F = " + number(f) +
+                          " (strength_reduction.max_factor): the factor of safety is at least that"
+                    : "strength reduction: factor of safety F = " + number(f) +
+                          " (converged at F = " + number(f) + ", not at F = " +
+                          number(out.failed_at) + " within " +
+                          std::to_string(model_.problem.time.implicit.max_iterations) +
+                          " Newton iterations; largest displacement since F = 1: " +
+                          number(out.max_displacement.back()) + " m)";
+  RunResult part;
+  scheme.report(part);
+  add_iterations(result.iterations, part.iterations);
+}
+
+}  // namespace hmpm
