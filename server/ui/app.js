@@ -1,4 +1,5 @@
-// The dashboard's entry point: hash routing (#/jobs, #/jobs/{id}, #/submit),
+// The dashboard's entry point: hash routing (#/jobs, #/jobs/{id}, #/submit,
+// #/ensembles, #/ensembles/{id}),
 // the header's token field and the server health dot. Each page module
 // exports render(main, params) returning an optional cleanup function,
 // called when the route changes (to stop polling and event streams).
@@ -7,12 +8,16 @@ import { get_json, set_token, token } from '/ui/api.js';
 import { set_field_units } from '/ui/dom.js';
 import * as job_list from '/ui/jobs.js';
 import * as job_page from '/ui/job.js';
+import * as ensemble_list from '/ui/ensembles.js';
+import * as ensemble_page from '/ui/ensemble.js';
 import * as submit_page from '/ui/submit.js';
 
 const routes = [
   [/^#\/jobs\/([^/]+)$/, job_page, 'jobs'],
   [/^#\/submit$/, submit_page, 'submit'],
   [/^#\/jobs$/, job_list, 'jobs'],
+  [/^#\/ensembles\/([^/]+)$/, ensemble_page, 'ensembles'],
+  [/^#\/ensembles$/, ensemble_list, 'ensembles'],
 ];
 
 let cleanup = null;

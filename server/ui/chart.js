@@ -54,7 +54,7 @@ export function line_chart(lines, { x_label = '', y_label = '', markers = false,
   const fx = x_log ? (v) => (v > 0 ? Math.log10(v) : NaN) : (v) => v;
   lines = lines.map((l) => ({ ...l, x: l.x.map(fx) }));
   const [x0, x1] = extent(lines.flatMap((l) => l.x));
-  const [y0, y1] = extent(lines.flatMap((l) => l.y));
+  const [y0, y1] = extent(lines.flatMap((l) => (l.y_low ? [...l.y, ...l.y_low] : l.y)));
   const sx = (v) => m.left + ((v - x0) / (x1 - x0)) * w;
   const sy = y_down ? (v) => m.top + ((v - y0) / (y1 - y0)) * hgt : (v) => m.top + hgt - ((v - y0) / (y1 - y0)) * hgt;
   const x_ticks = x_log ? ticks(Math.ceil(x0), Math.floor(x1), Math.max(1, Math.floor(x1) - Math.ceil(x0))).filter(Number.isInteger) : ticks(x0, x1);
@@ -83,12 +83,65 @@ export function line_chart(lines, { x_label = '', y_label = '', markers = false,
       if (ok) d += `${pen ? 'L' : 'M'}${sx(line.x[k]).toFixed(2)},${sy(line.y[k]).toFixed(2)}`;
       pen = ok;
     }
+    if (line.y_low) {
+      // A band between y_low and y (a fan plot's 5–95 %): filled, no outline.
+      let band = '';
+      const ok = (k) => Number.isFinite(line.x[k]) && Number.isFinite(line.y[k]) && Number.isFinite(line.y_low[k]);
+      for (let k = 0; k < line.x.length; ++k) if (ok(k)) band += `${band ? 'L' : 'M'}${sx(line.x[k]).toFixed(2)},${sy(line.y[k]).toFixed(2)}`;
+      for (let k = line.x.length - 1; k >= 0; --k) if (ok(k)) band += `L${sx(line.x[k]).toFixed(2)},${sy(line.y_low[k]).toFixed(2)}`;
+      const area = svg('path', { d: `${band}Z`, fill: colour, 'fill-opacity': 0.18, stroke: 'none', class: 'band', 'data-label': line.label });
+      area.append(svg('title', {}, line.label));
+      plot.append(area);
+      return;
+    }
     const path = svg('path', { d, fill: 'none', stroke: colour, 'stroke-width': 1.8, 'data-points': line.x.length, 'data-label': line.label });
     path.append(svg('title', {}, line.label));
     plot.append(path);
     if (markers) for (let k = 0; k < line.x.length; ++k) if (Number.isFinite(line.x[k]) && Number.isFinite(line.y[k])) plot.append(svg('circle', { cx: sx(line.x[k]), cy: sy(line.y[k]), r: 2.5, fill: colour }));
   });
   root.append(plot);
+  return root;
+}
+
+// Histogram of `values` as an SVG: about sqrt(n) equal bins (5 to 30)
+// between the smallest and largest value, bar heights the counts.
+export function histogram(values, { x_label = '', width = 760, height = 260 } = {}) {
+  const m = { left: 56, right: 16, top: 14, bottom: 46 };
+  const w = width - m.left - m.right;
+  const hgt = height - m.top - m.bottom;
+  const root = svg('svg', { viewBox: `0 0 ${width} ${height}`, class: 'chart histogram', role: 'img', 'aria-label': `histogram of ${x_label}`, 'data-samples': values.length });
+  if (!values.length) return root;
+  const bins = Math.max(5, Math.min(30, Math.round(Math.sqrt(values.length))));
+  let lo = Math.min(...values);
+  let hi = Math.max(...values);
+  if (!(hi > lo)) {
+    const pad = Math.abs(lo) * 0.05 || 1;
+    lo -= pad;
+    hi += pad;
+  }
+  const counts = new Array(bins).fill(0);
+  for (const v of values) counts[Math.min(bins - 1, Math.floor(((v - lo) / (hi - lo)) * bins))] += 1;
+  const top = Math.max(...counts);
+  const sx = (v) => m.left + ((v - lo) / (hi - lo)) * w;
+  const sy = (c) => m.top + hgt - (c / top) * hgt;
+  const grid = svg('g', { class: 'grid' });
+  const axes = svg('g', { class: 'axis' });
+  for (const t of ticks(lo, hi)) axes.append(svg('text', { x: sx(t), y: m.top + hgt + 16, 'text-anchor': 'middle' }, num(t)));
+  for (const t of ticks(0, top, Math.min(5, top)).filter(Number.isInteger)) {
+    grid.append(svg('line', { x1: m.left, x2: m.left + w, y1: sy(t), y2: sy(t) }));
+    axes.append(svg('text', { x: m.left - 6, y: sy(t) + 4, 'text-anchor': 'end' }, String(t)));
+  }
+  axes.append(svg('rect', { x: m.left, y: m.top, width: w, height: hgt, class: 'frame' }));
+  axes.append(svg('text', { x: m.left + w / 2, y: height - 8, 'text-anchor': 'middle', class: 'axis-label' }, x_label));
+  axes.append(svg('text', { x: 14, y: m.top + hgt / 2, 'text-anchor': 'middle', class: 'axis-label', transform: `rotate(-90 14 ${m.top + hgt / 2})` }, 'samples'));
+  const bars = svg('g', { class: 'bars' });
+  counts.forEach((c, i) => {
+    const x = sx(lo + ((hi - lo) * i) / bins);
+    const bar = svg('rect', { x: x + 1, y: sy(c), width: Math.max(1, w / bins - 2), height: m.top + hgt - sy(c), fill: PALETTE[0], 'data-count': c });
+    bar.append(svg('title', {}, `${c} samples`));
+    bars.append(bar);
+  });
+  root.append(grid, bars, axes);
   return root;
 }
 

@@ -392,5 +392,35 @@ class Dashboard(unittest.TestCase):
         self.assertEqual(self.call("GET", f"/jobs/{job_id}")["status"], "dismissed")
 
 
+    def test_ensemble_page_shows_samples_fan_plot_and_histogram(self):
+        spec = example("bar-vibration")
+        spec["time"]["end"] = min(spec["time"]["end"], 0.5)
+        spec.get("output", {}).pop("snapshots", None)
+        body = {"spec": spec, "samples": 24, "seed": 43,
+                "vary": [{"path": "/materials/bar/youngs_modulus",
+                          "distribution": {"lognormal": {"mean": spec["materials"]["bar"]["youngs_modulus"],
+                                                         "cov": 0.3}}}]}
+        eid = self.call("POST", "/ensembles", json.dumps(body).encode())["ensembleID"]
+        wait_until(lambda: self.call("GET", f"/ensembles/{eid}")["status"] in ("successful", "failed", "dismissed"),
+                   JOB_TIMEOUT_S, f"ensemble {eid} to end")
+        self.open(f"#/ensembles/{eid}")
+        wait_until(lambda: len(self.driver.find_elements(By.CSS_SELECTOR, "#sample-table tbody tr")) == 24,
+                   UI_TIMEOUT_S, "a row per sample")
+        rows = self.driver.find_elements(By.CSS_SELECTOR, "#sample-table tbody tr")
+        self.assertTrue(all(r.get_attribute("data-status") == "successful" for r in rows))
+        # the fan plot: a 5-95 % band and the median and mean lines
+        band = self.css("#ensemble-fan svg path.band")
+        self.assertEqual(band.get_attribute("data-label"), "5–95 %")
+        labels = {p.get_attribute("data-label") for p in
+                  self.driver.find_elements(By.CSS_SELECTOR, "#ensemble-fan svg path[data-points]")}
+        self.assertEqual(labels, {"median", "mean"})
+        # the histogram counts every successful sample
+        hist = self.css("#ensemble-histogram svg.histogram rect[data-count]")
+        counts = sum(int(r.get_attribute("data-count")) for r in
+                     self.driver.find_elements(By.CSS_SELECTOR, "#ensemble-histogram svg.histogram rect[data-count]"))
+        self.assertTrue(hist)
+        self.assertEqual(counts, 24)
+        self.screenshot("ensemble")
+
 if __name__ == "__main__":
     unittest.main(verbosity=2)

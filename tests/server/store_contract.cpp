@@ -56,6 +56,19 @@ NewJob StoreContract::job(const std::string& name, const std::string& key,
   return j;
 }
 
+NewEnsemble StoreContract::ensemble(int samples, const std::string& key,
+                                    const std::string& body_hash) {
+  static std::atomic<int> counter{0};
+  NewEnsemble e;
+  e.id = "e0000000-0000-4000-8000-" + std::to_string(100000000000 + counter++);
+  e.request = R"({"samples":)" + std::to_string(samples) + "}";
+  e.seed = 42;
+  e.idempotency_key = key;
+  e.body_sha256 = body_hash;
+  for (int k = 0; k < samples; ++k) e.samples.push_back(job("sample-" + std::to_string(k)));
+  return e;
+}
+
 Claimant StoreContract::live() {
   return Claimant{"live-instance", 600.0};
 }
@@ -556,6 +569,108 @@ TEST_P(StoreContract, AJobFailedByRecoveryForgetsItsCheckpoint) {
   EXPECT_EQ(store().record_checkpoint(claim, checkpoint_at(5, claim)), ClaimState::held);
   ASSERT_EQ(store().recover(1, 0.0).failed.size(), 1u);  // attempts 1 >= max 1
   EXPECT_FALSE(store().checkpoint(id));
+}
+
+// Ensembles: stored with all their samples or not at all (the queue cap
+// counts every sample); the samples are ordinary jobs in index order that
+// know their ensemble; an idempotency key replays the whole ensemble; the
+// state survives a reopen; an ensemble goes with its last purged sample.
+TEST_P(StoreContract, AnEnsembleIsStoredWithAllItsSamplesAsOrdinaryJobs) {
+  store().submit(job("before"), 100);
+  // Over the cap: nothing at all is stored.
+  const NewEnsemble too_many = ensemble(10);
+  EXPECT_EQ(store().submit_ensemble(too_many, 10).outcome, SubmitOutcome::queue_full);
+  EXPECT_FALSE(store().find_ensemble(too_many.id));
+  for (const NewJob& j : too_many.samples) EXPECT_FALSE(store().find(j.id));
+  EXPECT_EQ(store().list({}, "", 100).size(), 1u);
+
+  const NewEnsemble e = ensemble(4, "ens-key", "h1");
+  const auto created = store().submit_ensemble(e, 100);
+  ASSERT_EQ(created.outcome, SubmitOutcome::created);
+  EXPECT_EQ(created.ensemble.id, e.id);
+  EXPECT_EQ(created.ensemble.request, e.request);
+  EXPECT_EQ(created.ensemble.seed, 42);
+  EXPECT_EQ(created.ensemble.samples, 4);
+  EXPECT_EQ(created.ensemble.state, EnsembleState::active);
+  EXPECT_FALSE(created.ensemble.created.empty());
+  ASSERT_EQ(created.ensemble.jobs.size(), 4u);
+  for (int k = 0; k < 4; ++k) {
+    const EnsembleSample& sample = created.ensemble.jobs[static_cast<std::size_t>(k)];
+    EXPECT_EQ(sample.index, k);
+    EXPECT_EQ(sample.job_id, e.samples[static_cast<std::size_t>(k)].id);
+    EXPECT_EQ(sample.status, JobStatus::accepted);
+    const auto j = store().find(sample.job_id);
+    ASSERT_TRUE(j);
+    EXPECT_EQ(j->ensemble_id, e.id);
+    EXPECT_EQ(j->ensemble_index, k);
+    EXPECT_EQ(j->name, "sample-" + std::to_string(k));
+  }
+  EXPECT_EQ(store().find(store().list({}, "before", 1).at(0).id)->ensemble_index, -1);
+  EXPECT_TRUE(store().find(store().list({}, "before", 1).at(0).id)->ensemble_id.empty());
+  // The samples queue like any job (FIFO after the job before them).
+  const auto first = store().claim_next(live());
+  ASSERT_TRUE(first);
+  EXPECT_EQ(first->name, "before");
+  const auto sample0 = store().claim_next(live());
+  ASSERT_TRUE(sample0);
+  EXPECT_EQ(sample0->id, e.samples[0].id);
+  store().update_progress(claim_of(*sample0), 40);
+  auto found = store().find_ensemble(e.id);
+  ASSERT_TRUE(found);
+  EXPECT_EQ(found->jobs[0].status, JobStatus::running);
+  EXPECT_DOUBLE_EQ(found->jobs[0].progress, 40);
+  EXPECT_EQ(found->jobs[0].attempts, 1);
+
+  // The key replays the whole ensemble; another body under it is a conflict.
+  NewEnsemble again = ensemble(4, "ens-key", "h1");
+  const auto replayed = store().submit_ensemble(again, 100);
+  EXPECT_EQ(replayed.outcome, SubmitOutcome::replayed);
+  EXPECT_EQ(replayed.ensemble.id, e.id);
+  EXPECT_FALSE(store().find(again.samples[0].id));
+  EXPECT_EQ(store().submit_ensemble(ensemble(4, "ens-key", "h2"), 100).outcome,
+            SubmitOutcome::key_conflict);
+
+  // Newest first; the state is kept, and deleted stays deleted.
+  const NewEnsemble later = ensemble(2);
+  ASSERT_EQ(store().submit_ensemble(later, 100).outcome, SubmitOutcome::created);
+  const auto listed = store().list_ensembles(10);
+  ASSERT_EQ(listed.size(), 2u);
+  EXPECT_EQ(listed[0].id, later.id);
+  EXPECT_EQ(listed[1].id, e.id);
+  EXPECT_EQ(listed[1].jobs.size(), 4u);
+  EXPECT_EQ(store().list_ensembles(1).size(), 1u);
+  EXPECT_FALSE(store().find_ensemble("no-such-ensemble"));
+  EXPECT_FALSE(store().set_ensemble_state("no-such-ensemble", EnsembleState::cancelled));
+  const auto before = store().set_ensemble_state(e.id, EnsembleState::cancelled);
+  ASSERT_TRUE(before);
+  EXPECT_EQ(before->state, EnsembleState::active);
+  EXPECT_EQ(store().set_ensemble_state(e.id, EnsembleState::deleted)->state,
+            EnsembleState::cancelled);
+  EXPECT_EQ(store().set_ensemble_state(e.id, EnsembleState::cancelled)->state,
+            EnsembleState::deleted);
+  close();
+  EXPECT_EQ(store().find_ensemble(e.id)->state, EnsembleState::deleted);
+  EXPECT_EQ(store().find_ensemble(later.id)->state, EnsembleState::active);
+  EXPECT_EQ(store().find_ensemble(e.id)->jobs.size(), 4u);
+}
+
+TEST_P(StoreContract, AnEnsembleGoesWithItsLastPurgedSample) {
+  using std::chrono::hours;
+  const NewEnsemble e = ensemble(2);
+  ASSERT_EQ(store().submit_ensemble(e, 100).outcome, SubmitOutcome::created);
+  store().cancel(e.samples[0].id);
+  advance(hours(24 * 10));
+  EXPECT_EQ(store().purge_ended(now() - hours(24)), std::vector<std::string>{e.samples[0].id});
+  const auto left = store().find_ensemble(e.id);
+  ASSERT_TRUE(left) << "one sample is still queued";
+  ASSERT_EQ(left->jobs.size(), 1u);
+  EXPECT_EQ(left->jobs[0].index, 1);
+  EXPECT_EQ(left->samples, 2);
+  store().cancel(e.samples[1].id);
+  advance(hours(24 * 10));
+  EXPECT_EQ(store().purge_ended(now() - hours(24)), std::vector<std::string>{e.samples[1].id});
+  EXPECT_FALSE(store().find_ensemble(e.id));
+  EXPECT_TRUE(store().list_ensembles(10).empty());
 }
 
 TEST_P(StoreContract, ConcurrentWritersNeverFail) {

@@ -63,6 +63,10 @@ class StoreContract : public ::testing::TestWithParam<StoreBackend> {
   static NewJob job(const std::string& name, const std::string& key = "",
                     const std::string& body_hash = "");
 
+  /// A new ensemble of `samples` jobs named sample-0, sample-1, ... (unique ids).
+  static NewEnsemble ensemble(int samples, const std::string& key = "",
+                              const std::string& body_hash = "");
+
   /// This process's claimant: a lease that stays live for the whole test.
   static Claimant live();
   /// A claimant whose leases have lapsed as soon as they are taken (a dead process).

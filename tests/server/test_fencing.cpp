@@ -107,6 +107,19 @@ class PausedStore : public JobStore {
   std::optional<CheckpointRecord> checkpoint(const std::string& id) override {
     return inner_.checkpoint(id);
   }
+  EnsembleSubmitResult submit_ensemble(const NewEnsemble& e, std::int64_t max_queue) override {
+    return inner_.submit_ensemble(e, max_queue);
+  }
+  std::optional<EnsembleRecord> find_ensemble(const std::string& id) override {
+    return inner_.find_ensemble(id);
+  }
+  std::vector<EnsembleRecord> list_ensembles(int limit) override {
+    return inner_.list_ensembles(limit);
+  }
+  std::optional<EnsembleRecord> set_ensemble_state(const std::string& id,
+                                                   EnsembleState state) override {
+    return inner_.set_ensemble_state(id, state);
+  }
 
  private:
   JobStore& inner_;

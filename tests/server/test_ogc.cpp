@@ -8,9 +8,7 @@
 #include <set>
 #include <thread>
 
-#include "hmpm/server/service.hpp"
-#include "job_log.hpp"
-#include "support.hpp"
+#include "service_fixture.hpp"
 
 namespace hmpm::server {
 namespace {
@@ -21,46 +19,9 @@ const char* const browser_accept =
     "text/html,application/xhtml+xml,application/xml;q=0.9,image/avif,*/*;q=0.8";
 
 // One service on an ephemeral port for each test, with a client for it.
-class OgcTest : public ::testing::Test {
+class OgcTest : public ServiceTest {
  protected:
-  void SetUp() override {
-    set_logging_enabled(false);
-    dir_ = make_temp_dir("ogc");
-  }
-  void TearDown() override {
-    if (service_) {
-      service_->stop();
-      thread_.join();
-    }
-    std::filesystem::remove_all(dir_);
-  }
-
-  void start(long max_queue = 1000, const std::string& token = "") {
-    ServiceConfig c;
-    c.port = 0;
-    c.db_path = dir_ / "hmpm.sqlite";
-    c.workers = 1;
-    c.threads_per_job = 1;
-    c.max_queue = max_queue;
-    c.token = token;
-    service_ = std::make_unique<Service>(std::move(c));
-    const int port = service_->bind();
-    ASSERT_GT(port, 0);
-    thread_ = std::thread([this] { service_->run(); });
-    for (int i = 0; i < 1000 && !service_->is_running(); ++i)
-      std::this_thread::sleep_for(std::chrono::milliseconds(5));
-    ASSERT_TRUE(service_->is_running());
-    client_ = std::make_unique<httplib::Client>("127.0.0.1", port);
-    client_->set_read_timeout(30, 0);
-  }
-
-  Json get_json(const std::string& path, int status = 200) {
-    auto res = client_->Get(path.c_str());
-    EXPECT_TRUE(res) << path;
-    if (!res) return {};
-    EXPECT_EQ(res->status, status) << path << ": " << res->body;
-    return json_of(res->body);
-  }
+  OgcTest() : ServiceTest("ogc") {}
 
   httplib::Result execute(const Json& request, const httplib::Headers& headers = {},
                           const std::string& process = "hmpm") {
@@ -87,11 +48,6 @@ class OgcTest : public ::testing::Test {
     for (const Json& e : doc.value("errors", Json::array())) paths.push_back(e["path"]);
     return {doc.value("type", ""), paths};
   }
-
-  std::filesystem::path dir_;
-  std::unique_ptr<Service> service_;
-  std::thread thread_;
-  std::unique_ptr<httplib::Client> client_;
 };
 
 TEST_F(OgcTest, LandingPageLinksConformanceProcessesAndJobs) {

@@ -305,6 +305,7 @@ TEST_F(RoutesTest, HostileBodiesGetProblemDocumentsAndTheServerKeepsAnswering) {
 TEST_F(RoutesTest, AllowListsExactlyTheMethodsServed) {
   start();
   const std::string job = "/jobs/00000000-0000-4000-8000-000000000000";
+  const std::string ensemble = "/ensembles/00000000-0000-4000-8000-000000000000";
   const std::vector<std::pair<std::string, std::string>> expected{
       {"/health", "GET, HEAD, OPTIONS"},
       {"/metrics", "GET, HEAD, OPTIONS"},
@@ -314,6 +315,11 @@ TEST_F(RoutesTest, AllowListsExactlyTheMethodsServed) {
       {job + "/results", "GET, HEAD, OPTIONS"},
       {job + "/results/summary.json", "GET, HEAD, OPTIONS"},
       {job + "/events", "GET, HEAD, OPTIONS"},
+      {"/ensembles", "GET, HEAD, POST, OPTIONS"},
+      {ensemble, "GET, HEAD, DELETE, OPTIONS"},
+      {ensemble + "/cancel", "POST, OPTIONS"},
+      {ensemble + "/results", "GET, HEAD, OPTIONS"},
+      {ensemble + "/results/statistics.json", "GET, HEAD, OPTIONS"},
   };
   for (const auto& [path, allow] : expected) {
     auto res = client_->Patch(path.c_str(), "{}", "application/json");

@@ -10,7 +10,8 @@ From the shell: `python3 -m hmpm_client --url URL submit SPEC --wait
 """
 
 from .client import DEFAULT_URL, TERMINAL_STATUSES, Client, Job
+from .ensemble import Ensemble
 from .errors import HmpmError
 
-__all__ = ["Client", "Job", "HmpmError", "TERMINAL_STATUSES", "DEFAULT_URL"]
+__all__ = ["Client", "Job", "Ensemble", "HmpmError", "TERMINAL_STATUSES", "DEFAULT_URL"]
 __version__ = "0.1.0"

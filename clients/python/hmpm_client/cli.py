@@ -6,9 +6,15 @@
     python3 -m hmpm_client --url URL cancel ID     # stop a queued/running job, keep its files
     python3 -m hmpm_client --url URL delete ID     # dismiss a job and delete its files
     python3 -m hmpm_client --url URL plot ID|DIR --field pore_pressure [--out FILE.png] [--profile LINE | --consolidation]
+    python3 -m hmpm_client --url URL ensemble submit REQUEST.json [--wait] [--download DIR]
+    python3 -m hmpm_client --url URL ensemble wait ID | stats ID [--json] | download ID DIR
+    python3 -m hmpm_client --url URL ensemble status ID | list | cancel ID | delete ID
 
 `plot` takes a job id, or a local folder holding series.json (what
 `download` or `hmpm run --out` wrote), so no service is needed for it.
+
+An ensemble request is {"spec", "samples", "seed", "vary"} (docs/api.md,
+Ensembles); `ensemble stats` prints the figures at the last time.
 
 Exit status: 0 success (for submit --wait and wait: the job succeeded);
 1 the service refused the request or could not be reached; 2 bad usage or a
@@ -98,6 +104,34 @@ def _parser() -> argparse.ArgumentParser:
     s.add_argument("--consolidation", action="store_true",
                    help="plot consolidation.json (the average degree of consolidation and the "
                         "average excess pore pressure over time) instead of the series")
+
+    e = sub.add_parser("ensemble", help="ensembles of jobs: submit, wait, stats, download, ...")
+    esub = e.add_subparsers(dest="ensemble_command", metavar="ACTION")
+    esub.required = True
+    s = esub.add_parser("submit", help="submit an ensemble request (JSON file, or - for stdin)")
+    s.add_argument("request", metavar="REQUEST")
+    s.add_argument("--wait", action="store_true", help="wait until every sample has ended")
+    s.add_argument("--download", metavar="DIR",
+                   help="then download samples.json and statistics.json into DIR (implies --wait)")
+    s.add_argument("--idempotency-key", metavar="KEY", help="repeat-safe submission key")
+    s.add_argument("--quiet", "-q", action="store_true", help="no progress lines")
+    for action, text in (("status", "print an ensemble's status document"),
+                         ("wait", "wait until every sample of an ensemble has ended"),
+                         ("cancel", "cancel every sample not yet ended"),
+                         ("delete", "dismiss every sample and delete its files")):
+        s = esub.add_parser(action, help=text)
+        s.add_argument("id")
+        if action == "wait":
+            s.add_argument("--quiet", "-q", action="store_true", help="no progress lines")
+    s = esub.add_parser("stats", help="the statistics at the last time (mean, std, p05, p50, p95)")
+    s.add_argument("id")
+    s.add_argument("--json", action="store_true", help="print the whole statistics.json")
+    s = esub.add_parser("download", help="download samples.json and statistics.json into DIR")
+    s.add_argument("id")
+    s.add_argument("dir")
+    s = esub.add_parser("list", help="list ensembles")
+    s.add_argument("--status", metavar="S[,S...]")
+    s.add_argument("--limit", type=int)
     return p
 
 
@@ -134,19 +168,32 @@ def _download(job: Job, directory: str) -> None:
     print(f"{PROG}: downloaded {len(paths)} files to {directory} (sha256 verified)", file=sys.stderr)
 
 
-def cmd_submit(client: Client, args) -> int:
-    if args.spec == "-":
-        spec: Any = sys.stdin.buffer.read()
-    else:
-        if not Path(args.spec).is_file():
-            _err(f"{args.spec}: no such file")
-            return EXIT_INVALID
-        spec = args.spec
-    job = client.submit(spec, idempotency_key=args.idempotency_key)
-    print(job.id, flush=True)
-    for w in job.warnings:
+def _input(name: str) -> Any:
+    """What to submit: stdin's bytes for "-", else the file's path (None,
+    said on stderr, when there is no such file)."""
+    if name == "-":
+        return sys.stdin.buffer.read()
+    if not Path(name).is_file():
+        _err(f"{name}: no such file")
+        return None
+    return name
+
+
+def _submitted(handle: Any, args) -> bool:
+    """Prints a new job's or ensemble's id (stdout) and warnings (stderr);
+    whether to wait for it."""
+    print(handle.id, flush=True)
+    for w in handle.warnings:
         _err(f"warning: {w.get('path', '')}: {w.get('message', '')}")
-    if not (args.wait or args.download):
+    return bool(args.wait or args.download)
+
+
+def cmd_submit(client: Client, args) -> int:
+    spec = _input(args.spec)
+    if spec is None:
+        return EXIT_INVALID
+    job = client.submit(spec, idempotency_key=args.idempotency_key)
+    if not _submitted(job, args):
         return EXIT_OK
     doc = _wait(job, args)
     code = _finish(job, doc)
@@ -274,9 +321,65 @@ def cmd_plot(client: Client, args) -> int:
     return EXIT_OK
 
 
+def _ensemble_finish(doc: Dict[str, Any]) -> int:
+    if doc.get("status") == "successful":
+        return EXIT_OK
+    _err(f"ensemble {doc.get('ensembleID')} {doc.get('status')}: {doc.get('counts')}")
+    return EXIT_JOB_FAILED
+
+
+def cmd_ensemble(client: Client, args) -> int:
+    from .ensemble import final_statistics, format_status
+    action = args.ensemble_command
+    if action == "submit":
+        request = _input(args.request)
+        if request is None:
+            return EXIT_INVALID
+        ens = client.submit_ensemble(request, idempotency_key=args.idempotency_key)
+        if not _submitted(ens, args):
+            return EXIT_OK
+        code = _ensemble_finish(ens.wait(progress=not args.quiet, timeout=args.timeout))
+        if args.download:
+            paths = ens.download(args.download)
+            _err(f"downloaded {len(paths)} files to {args.download} (sha256 verified)")
+        return code
+    if action == "list":
+        for d in client.ensembles(status=args.status, limit=args.limit):
+            print(format_status(d))
+        return EXIT_OK
+    ens = client.ensemble(args.id)
+    if action == "status":
+        _print_json(ens.status())
+    elif action == "wait":
+        return _ensemble_finish(ens.wait(progress=not args.quiet, timeout=args.timeout))
+    elif action == "cancel":
+        print(format_status(ens.cancel()))
+    elif action == "delete":
+        print(format_status(ens.delete()))
+    elif action == "stats":
+        stats = ens.statistics()
+        if args.json:
+            _print_json(stats)
+            return EXIT_OK
+        times = stats.get("time") or []
+        print(f"{stats.get('samples', 0)} successful samples; figures at t = "
+              f"{times[-1] if times else '?'} s")
+        print(f"{'particle':>8}  {'field':<20} {'mean':>12} {'std':>12} {'p05':>12} {'p50':>12} {'p95':>12}")
+        for row in final_statistics(stats):
+            name = row["field"] + (f"[{row['component']}]" if row["component"] is not None else "")
+            cells = " ".join(f"{row[k]:>12.5g}" if isinstance(row[k], (int, float)) else f"{'-':>12}"
+                             for k in ("mean", "std", "p05", "p50", "p95"))
+            print(f"{row['particle']!s:>8}  {name:<20} {cells}")
+    elif action == "download":
+        paths = ens.download(args.dir)
+        _err(f"downloaded {len(paths)} files to {args.dir} (sha256 verified)")
+    return EXIT_OK
+
+
 COMMANDS = {
     "submit": cmd_submit, "status": cmd_status, "wait": cmd_wait, "list": cmd_list,
     "cancel": cmd_cancel, "delete": cmd_delete, "log": cmd_log, "results": cmd_results, "download": cmd_download, "plot": cmd_plot,
+    "ensemble": cmd_ensemble,
 }
 
 

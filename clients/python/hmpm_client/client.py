@@ -193,11 +193,37 @@ class Client:
         """A handle on an existing job (no request is made)."""
         return Job(self, job_id)
 
+    # -- Ensembles (ensemble.py) -------------------------------------------
+
+    def submit_ensemble(self, request: SpecLike, idempotency_key: Optional[str] = None):
+        """`POST /ensembles`: submits an ensemble request (`{"spec", "samples",
+        "seed", "vary"}`: a path, dict, JSON text or bytes) and returns its
+        Ensemble. Raises HmpmError when it is refused (`.errors` lists every
+        JSON path and message)."""
+        from .ensemble import submit_ensemble
+        return submit_ensemble(self, request, idempotency_key)
+
+    def ensemble(self, ensemble_id: str):
+        """A handle on an existing ensemble (no request is made)."""
+        from .ensemble import Ensemble
+        return Ensemble(self, ensemble_id)
+
+    def ensembles(self, status: Union[str, Sequence[str], None] = None,
+                  limit: Optional[int] = None) -> List[Dict[str, Any]]:
+        """`GET /ensembles`: ensemble documents, newest first, of the given
+        status (as for jobs), at most `limit`."""
+        return self._list("ensembles", status, limit)
+
     def jobs(self, status: Union[str, Sequence[str], None] = None,
              limit: Optional[int] = None, name: Optional[str] = None) -> List[Dict[str, Any]]:
         """`GET /jobs`: status documents, newest first, of the given status
         (one name, a comma-separated string or a list) and job `name`, at
         most `limit`."""
+        return self._list("jobs", status, limit, name)
+
+    def _list(self, collection: str, status: Union[str, Sequence[str], None],
+              limit: Optional[int], name: Optional[str] = None) -> List[Dict[str, Any]]:
+        """GET /jobs or /ensembles with the status, limit and name filters."""
         query = {}
         if status:
             query["status"] = status if isinstance(status, str) else ",".join(status)
@@ -205,10 +231,10 @@ class Client:
             query["name"] = name
         if limit is not None:
             query["limit"] = str(int(limit))
-        path = "/jobs" + ("?" + urllib.parse.urlencode(query) if query else "")
+        path = f"/{collection}" + ("?" + urllib.parse.urlencode(query) if query else "")
         doc = self.request("GET", path)
         if isinstance(doc, dict):
-            doc = doc.get("jobs", [])
+            doc = doc.get(collection, [])
         return list(doc or [])
 
 
@@ -413,12 +439,7 @@ class Job:
         return list(files)
 
     def _file_url(self, entry: Dict[str, Any]) -> str:
-        href = entry.get("href")
-        if isinstance(href, str) and href:
-            url = urllib.parse.urljoin(self.client.url + "/", href)
-            if self.client._same_origin(url):
-                return url
-        return self.path + "/results/" + urllib.parse.quote(str(entry["name"]), safe="/")
+        return result_url(self.client, self.path, entry)
 
     def open_result(self, name: str):
         """Opens the result file `name` as an HTTP response (caller closes)."""
@@ -445,35 +466,55 @@ class Job:
         manifest's size and sha256, then renamed; returns the paths written.
         Raises HmpmError (type `checksum-mismatch`) if a file does not match.
         """
-        root = Path(directory)
-        root.mkdir(parents=True, exist_ok=True)
-        written = []
-        for entry in self.results():
-            rel = _safe_relative(str(entry.get("name", "")))
-            target = root / rel
-            target.parent.mkdir(parents=True, exist_ok=True)
-            part = target.with_name(target.name + ".part")
-            digest = hashlib.sha256()
-            size = 0
-            with self.client.open("GET", self._file_url(entry), timeout=max(self.client.timeout, 120.0)) as resp, \
-                    open(part, "wb") as out:
-                while True:
-                    chunk = resp.read(1 << 16)
-                    if not chunk:
-                        break
-                    digest.update(chunk)
-                    size += len(chunk)
-                    out.write(chunk)
-            want_sha = str(entry.get("sha256") or "").lower()
-            want_size = entry.get("size")
-            if (want_sha and digest.hexdigest() != want_sha) or (isinstance(want_size, int) and size != want_size):
-                part.unlink()
-                raise HmpmError({"type": "checksum-mismatch", "title": "downloaded file does not match the manifest",
-                                 "detail": f"{rel}: got {size} bytes sha256 {digest.hexdigest()}, "
-                                           f"manifest says {want_size} bytes sha256 {want_sha}"})
-            os.replace(part, target)
-            written.append(target)
-        return written
+        return download_files(self.client, self.results(), directory, self._file_url)
+
+
+def result_url(client: Client, path: str, entry: Dict[str, Any]) -> str:
+    """Where to fetch a manifest entry of the resource at `path` (a job or an
+    ensemble): its `href` on this service, else `path/results/name`."""
+    href = entry.get("href")
+    if isinstance(href, str) and href:
+        url = urllib.parse.urljoin(client.url + "/", href)
+        if client._same_origin(url):
+            return url
+    return path + "/results/" + urllib.parse.quote(str(entry["name"]), safe="/")
+
+
+def download_files(client: Client, entries: List[Dict[str, Any]],
+                   directory: Union[str, "os.PathLike[str]"], file_url) -> List[Path]:
+    """Downloads the manifest `entries` (name, size, sha256) into `directory`,
+    each from `file_url(entry)`: to a temporary name, checked against the
+    manifest's size and sha256, then renamed. Returns the paths written;
+    raises HmpmError (type `checksum-mismatch`) if a file does not match."""
+    root = Path(directory)
+    root.mkdir(parents=True, exist_ok=True)
+    written = []
+    for entry in entries:
+        rel = _safe_relative(str(entry.get("name", "")))
+        target = root / rel
+        target.parent.mkdir(parents=True, exist_ok=True)
+        part = target.with_name(target.name + ".part")
+        digest = hashlib.sha256()
+        size = 0
+        with client.open("GET", file_url(entry), timeout=max(client.timeout, 120.0)) as resp, \
+                open(part, "wb") as out:
+            while True:
+                chunk = resp.read(1 << 16)
+                if not chunk:
+                    break
+                digest.update(chunk)
+                size += len(chunk)
+                out.write(chunk)
+        want_sha = str(entry.get("sha256") or "").lower()
+        want_size = entry.get("size")
+        if (want_sha and digest.hexdigest() != want_sha) or (isinstance(want_size, int) and size != want_size):
+            part.unlink()
+            raise HmpmError({"type": "checksum-mismatch", "title": "downloaded file does not match the manifest",
+                             "detail": f"{rel}: got {size} bytes sha256 {digest.hexdigest()}, "
+                                       f"manifest says {want_size} bytes sha256 {want_sha}"})
+        os.replace(part, target)
+        written.append(target)
+    return written
 
 
 def _lines(resp):

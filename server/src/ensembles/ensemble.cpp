@@ -230,6 +230,34 @@ double quantile(std::vector<double>& values, double q) {
   return values[lo] + (h - static_cast<double>(lo)) * (values[hi] - values[lo]);
 }
 
+Summary summarise(const std::vector<SampleState>& samples) {
+  Summary out;
+  std::vector<int> count(job_statuses.size(), 0);
+  double total = 0;
+  for (const SampleState& s : samples) {
+    ++count[static_cast<std::size_t>(s.status)];
+    total += is_terminal(s.status) ? 100.0 : std::clamp(s.progress, 0.0, 100.0);
+  }
+  out.progress = samples.empty() ? 100.0 : total / static_cast<double>(samples.size());
+  out.counts = json::object();
+  for (const JobStatusInfo& row : job_statuses)
+    out.counts[std::string(row.name)] = count[static_cast<std::size_t>(row.status)];
+  const auto n = [&](JobStatus s) { return count[static_cast<std::size_t>(s)]; };
+  const int waiting = n(JobStatus::accepted);
+  const int unfinished = waiting + n(JobStatus::running);
+  if (unfinished > 0)
+    out.status = unfinished == waiting && static_cast<std::size_t>(waiting) == samples.size()
+                     ? JobStatus::accepted
+                     : JobStatus::running;
+  else if (n(JobStatus::dismissed) > 0)
+    out.status = JobStatus::dismissed;
+  else if (n(JobStatus::failed) > 0)
+    out.status = JobStatus::failed;
+  else
+    out.status = JobStatus::successful;
+  return out;
+}
+
 namespace {
 
 /// The five figures of one scalar over the samples.

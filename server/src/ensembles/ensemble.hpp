@@ -24,6 +24,7 @@
 
 #include "hmpm/api/job.hpp"
 #include "hmpm/random_field.hpp"
+#include "hmpm/server/job_status.hpp"
 
 namespace hmpm::server::ensembles {
 
@@ -73,5 +74,29 @@ json statistics(const std::vector<json>& series);
 
 /// q-quantile (0..1) of `values` (sorted in place), linear interpolation.
 double quantile(std::vector<double>& values, double q);
+
+/// One sample as the ensemble's status needs it.
+struct SampleState {
+  JobStatus status = JobStatus::accepted;
+  double progress = 0.0;  ///< percent
+};
+
+/// An ensemble's status and progress, derived from its samples'.
+// NOLINTNEXTLINE(bugprone-exception-escape): json's defaulted members (never throw for null)
+struct Summary {
+  JobStatus status = JobStatus::accepted;
+  double progress = 0.0;  ///< percent, 0..100
+  /// How many samples are in each status (every status present, 0 or more).
+  json counts;
+};
+
+/// The status derived from the samples': accepted while none has started
+/// or ended; running while some have and others wait or run; once all have
+/// ended, dismissed if any was dismissed (the ensemble was cancelled or
+/// deleted), else failed if any failed, else successful. Progress is the
+/// mean of the samples' progress, an ended sample counting 100 (a failed
+/// or cancelled sample is done too). No samples (retention purged them
+/// all): successful at 100.
+Summary summarise(const std::vector<SampleState>& samples);
 
 }  // namespace hmpm::server::ensembles

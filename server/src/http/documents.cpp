@@ -66,6 +66,11 @@ Json status_document(const JobRecord& job) {
        link(self + "/results", "results", "application/json", "manifest of the result files"),
        link(self + "/events", "events", "text/event-stream", "progress as Server-Sent Events"),
        link(self + "/log", "log", "text/plain", "the job's log")});
+  if (!job.ensemble_id.empty()) {
+    doc["ensemble"] = Json{{"ensembleID", job.ensemble_id}, {"index", job.ensemble_index}};
+    doc["links"].push_back(link("/ensembles/" + job.ensemble_id, "up", "application/json",
+                                "the ensemble this job is a sample of"));
+  }
   return doc;
 }
 

@@ -40,6 +40,17 @@ void get_job_log(Context& c, const httplib::Request& req, httplib::Response& res
 void validate_spec(Context& c, const httplib::Request& req, httplib::Response& res,
                    const std::string& body);
 
+// ensembles.cpp — ensembles of jobs (contract v3); path parameter 1 is the
+// ensemble id, 2 a result file name.
+void post_ensemble(Context& c, const httplib::Request& req, httplib::Response& res,
+                   const std::string& body);
+void list_ensembles(Context& c, const httplib::Request& req, httplib::Response& res);
+void get_ensemble(Context& c, const httplib::Request& req, httplib::Response& res);
+void cancel_ensemble(Context& c, const httplib::Request& req, httplib::Response& res);
+void delete_ensemble(Context& c, const httplib::Request& req, httplib::Response& res);
+void get_ensemble_manifest(Context& c, const httplib::Request& req, httplib::Response& res);
+void get_ensemble_file(Context& c, const httplib::Request& req, httplib::Response& res);
+
 // results.cpp — the manifest and the files of a finished job.
 void get_manifest(Context& c, const httplib::Request& req, httplib::Response& res);
 void get_result_file(Context& c, const httplib::Request& req, httplib::Response& res);

@@ -15,11 +15,14 @@
 #include "job_log.hpp"
 #include "problem.hpp"
 #include "run_log.hpp"
+#include "submission.hpp"
 
 namespace hmpm::server::http {
 namespace {
 
 constexpr std::size_t max_reported_errors = 200;
+
+}  // namespace
 
 JobCost cost_of(const hmpm::api::CostEstimate& c) {
   return JobCost{.particles = c.particles,
@@ -32,9 +35,9 @@ JobCost cost_of(const hmpm::api::CostEstimate& c) {
                  .dt = c.dt};
 }
 
-// This server's calibration and threads per job. A spec is parsed with it,
-// so the one estimate of a request (ParsedJob::cost) is what the limits are
-// checked against and what the 201, /validate and GET /jobs/{id} show.
+// A spec is parsed with this server's calibration, so the one estimate of a
+// request (ParsedJob::cost) is what the limits are checked against and what
+// the 201, /validate and GET /jobs/{id} show.
 hmpm::api::Calibration server_calibration(const Context& c) {
   hmpm::api::Calibration calibration;
   if (c.config.seconds_per_particle_step > 0) {
@@ -45,8 +48,6 @@ hmpm::api::Calibration server_calibration(const Context& c) {
   return calibration;
 }
 
-// The cost document with the wall-time estimate of every scheme, from
-// this server's calibration (POST /validate and the 201 of POST /jobs).
 Json cost_with_estimate(const hmpm::api::CostEstimate& cost) {
   const hmpm::api::Calibration& calibration = cost.calibration;
   Json doc = cost_document(cost_of(cost));
@@ -75,36 +76,38 @@ Json spec_issues(const std::vector<hmpm::api::SpecError>& issues) {
   return out;
 }
 
+namespace {
+
 constexpr int max_candidates = 20;
 constexpr std::size_t full_id_length = 36;
 
 // How long POST /jobs/{id}/cancel waits for the worker to record the files.
 constexpr double cancel_wait_s = 5.0;
 
-// The 400 invalid-spec of POST /jobs and POST /validate.
-void send_invalid_spec(httplib::Response& res, const std::vector<hmpm::api::SpecError>& errors) {
+}  // namespace
+
+void send_invalid_spec(httplib::Response& res, const std::vector<hmpm::api::SpecError>& errors,
+                       const std::string& what) {
   const std::string detail = std::to_string(errors.size()) +
-                             (errors.size() == 1 ? " problem" : " problems") +
-                             " in the job spec; see errors";
-  send_problem(res, 400, "invalid-spec", "Invalid job spec", detail,
+                             (errors.size() == 1 ? " problem" : " problems") + " in the " + what +
+                             "; see errors";
+  send_problem(res, 400, "invalid-spec", "Invalid " + what, detail,
                Json{{"errors", spec_issues(errors)}});
 }
 
-// 422 limit-exceeded when the job's estimate is over a limit of this
-// server (job_limits.hpp); returns whether it answered.
 bool refuse_over_limits(const Context& c, httplib::Response& res,
-                        const hmpm::api::CostEstimate& cost) {
+                        const hmpm::api::CostEstimate& cost, const std::string& prefix) {
   const std::vector<LimitExceeded> over = exceeded_limits(cost, c.config);
   if (over.empty()) return false;
   Json limits = Json::array();
-  std::string detail;
+  std::string detail = prefix;
   for (const LimitExceeded& l : over) {
     limits.push_back(Json{{"limit", l.limit},
                           {"value", l.value},
                           {"estimate", l.estimate},
                           {"unit", l.unit},
                           {"option", l.option}});
-    detail += (detail.empty() ? "" : "; ") + l.limit + ": the job's estimate is " +
+    detail += (detail.size() == prefix.size() ? "" : "; ") + l.limit + ": the job's estimate is " +
               hmpm::format_significant(l.estimate, 3) + " " + l.unit + ", the limit " +
               hmpm::format_significant(l.value, 3) + " (hmpm-server " + l.option + ")";
   }
@@ -113,13 +116,14 @@ bool refuse_over_limits(const Context& c, httplib::Response& res,
   return true;
 }
 
-// 503 validation-busy: every validation turn is taken (validation_gate.hpp).
 void send_validation_busy(const Context& c, httplib::Response& res) {
   res.set_header("Retry-After", "2");
   send_problem(res, 503, "validation-busy", "Too many specs being validated",
                "the server is validating " + std::to_string(c.validation.admitted_max()) +
                    " job specs already; retry in a moment");
 }
+
+namespace {
 
 void log_dismissal(const std::string& id, JobStatus from, const char* how) {
   log_line({{"event", "job"},
@@ -158,9 +162,6 @@ std::optional<JobRecord> find_job(Context& c, const std::string& ref, httplib::R
   return job;
 }
 
-namespace {
-
-// Jobs waiting to run (status accepted).
 std::int64_t queued_jobs(Context& c) {
   const StatusCounts counts = c.store.count_by_status();
   const auto it = counts.find(JobStatus::accepted);
@@ -174,7 +175,22 @@ void send_queue_full(const Context& c, httplib::Response& res) {
       "the queue holds " + std::to_string(c.config.max_queue) + " jobs already; retry later");
 }
 
-}  // namespace
+std::optional<std::string> admit_submission(const Context& c, const httplib::Request& req,
+                                            httplib::Response& res) {
+  if (c.stopping) {
+    res.set_header("Retry-After", "5");
+    send_problem(res, 503, "shutting-down", "Shutting down",
+                 "the server is stopping; submit again once it is back");
+    return std::nullopt;
+  }
+  std::string key = req.get_header_value("Idempotency-Key");
+  if (key.size() > 255) {
+    send_problem(res, 400, "bad-request", "Bad request",
+                 "Idempotency-Key must be at most 255 characters");
+    return std::nullopt;
+  }
+  return key;
+}
 
 void post_job(Context& c, const httplib::Request& req, httplib::Response& res,
               const std::string& body) {
@@ -183,16 +199,9 @@ void post_job(Context& c, const httplib::Request& req, httplib::Response& res,
 
 void submit_job(Context& c, const httplib::Request& req, httplib::Response& res,
                 const std::string& spec, const std::string& body) {
-  if (c.stopping) {
-    res.set_header("Retry-After", "5");
-    return send_problem(res, 503, "shutting-down", "Shutting down",
-                        "the server is stopping; submit again once it is back");
-  }
-  const std::string key = req.get_header_value("Idempotency-Key");
-  if (key.size() > 255) {
-    return send_problem(res, 400, "bad-request", "Bad request",
-                        "Idempotency-Key must be at most 255 characters");
-  }
+  const auto admitted = admit_submission(c, req, res);
+  if (!admitted) return;
+  const std::string& key = *admitted;
 
   // A full queue is answered before any validation work: a count, not a parse.
   if (queued_jobs(c) >= c.config.max_queue) return send_queue_full(c, res);
@@ -264,26 +273,35 @@ std::vector<std::string> param_values(const httplib::Request& req, const char* p
 
 }  // namespace
 
-void list_jobs(Context& c, const httplib::Request& req, httplib::Response& res) {
-  std::vector<JobStatus> statuses;
+bool read_list_parameters(const httplib::Request& req, httplib::Response& res,
+                          std::vector<JobStatus>& statuses, int& limit) {
   for (const std::string& value : param_values(req, "status")) {
     const auto status = parse_status(value);
     if (!status) {
-      return send_invalid_parameter(res, "status must be " + status_names_text(), "status",
-                                    "unknown status '" + value + "'");
+      send_invalid_parameter(res, "status must be " + status_names_text(), "status",
+                             "unknown status '" + value + "'");
+      return false;
     }
     statuses.push_back(*status);
   }
-  const std::string name = req.get_param_value("name");
-  int limit = 100;
+  limit = 100;
   if (req.has_param("limit")) {
     const std::string v = req.get_param_value("limit");
     const auto [end, ec] = std::from_chars(v.data(), v.data() + v.size(), limit);
     if (ec != std::errc() || end != v.data() + v.size() || limit < 1 || limit > 1000) {
-      return send_invalid_parameter(res, "limit must be an integer from 1 to 1000", "limit",
-                                    "must be 1..1000");
+      send_invalid_parameter(res, "limit must be an integer from 1 to 1000", "limit",
+                             "must be 1..1000");
+      return false;
     }
   }
+  return true;
+}
+
+void list_jobs(Context& c, const httplib::Request& req, httplib::Response& res) {
+  std::vector<JobStatus> statuses;
+  int limit = 100;
+  if (!read_list_parameters(req, res, statuses, limit)) return;
+  const std::string name = req.get_param_value("name");
   // OGC API – Processes job-list filters: every job here is of process
   // "hmpm" and of type "process", so they keep all jobs or none.
   bool none = false;
@@ -355,11 +373,23 @@ void get_job_log(Context& c, const httplib::Request& req, httplib::Response& res
   res.set_content(text.str(), "text/plain; charset=utf-8");
 }
 
+std::optional<JobRecord> cancel_one(Context& c, const std::string& id) {
+  auto before = c.store.cancel(id);
+  if (!before || is_terminal(before->status)) return before;
+  append_run_log(c.files.job_dir(id),
+                 std::string("cancelled by the client while ") + status_name(before->status));
+  log_dismissal(id, before->status, "cancel");
+  // A worker of this process records the files written so far; give it a
+  // moment so the manifest is complete when the client reads it.
+  if (before->status == JobStatus::running) c.workers.cancel(id, cancel_wait_s);
+  return before;
+}
+
 void cancel_job(Context& c, const httplib::Request& req, httplib::Response& res) {
   const auto job = find_job(c, req.matches[1], res);
   if (!job) return;
   const std::string& id = job->id;
-  const auto before = c.store.cancel(id);
+  const auto before = cancel_one(c, id);
   if (!before) return send_no_such_job(res, id);
   if (is_terminal(before->status)) {
     return send_problem(res, 409, "job-finished", "Job already ended",
@@ -367,26 +397,26 @@ void cancel_job(Context& c, const httplib::Request& req, httplib::Response& res)
                             "); nothing was changed",
                         Json{{"jobID", id}, {"jobStatus", status_name(before->status)}});
   }
-  append_run_log(c.files.job_dir(id),
-                 std::string("cancelled by the client while ") + status_name(before->status));
-  log_dismissal(id, before->status, "cancel");
-  // A worker of this process records the files written so far; give it a
-  // moment so the manifest is complete when the client reads it.
-  if (before->status == JobStatus::running) c.workers.cancel(id, cancel_wait_s);
   const auto after = c.store.find(id);
   if (!after) return send_no_such_job(res, id);
   send_json(res, 202, status_document(*after));
+}
+
+std::optional<JobRecord> delete_one(Context& c, const std::string& id) {
+  auto before = c.store.dismiss(id);
+  if (!before) return before;
+  // A worker of this process removes the files itself once it has stopped.
+  if (!c.workers.cancel(id) && !before->results_deleted) c.files.remove(id);
+  if (before->status != JobStatus::dismissed) log_dismissal(id, before->status, "delete");
+  return before;
 }
 
 void dismiss_job(Context& c, const httplib::Request& req, httplib::Response& res) {
   const auto job = find_job(c, req.matches[1], res);
   if (!job) return;
   const std::string& id = job->id;
-  const auto before = c.store.dismiss(id);
+  const auto before = delete_one(c, id);
   if (!before) return send_no_such_job(res, id);
-  // A worker of this process removes the files itself once it has stopped.
-  if (!c.workers.cancel(id) && !before->results_deleted) c.files.remove(id);
-  if (before->status != JobStatus::dismissed) log_dismissal(id, before->status, "delete");
   const auto after = c.store.find(id);
   if (!after) return send_no_such_job(res, id);
   send_json(res, 200, status_document(*after));

@@ -17,6 +17,9 @@ namespace {
 // with find_job (jobs.cpp).
 const std::string job = "/jobs/([0-9a-f]{4}[0-9a-f-]{0,32})";
 
+// An ensemble id (in full).
+const std::string ensemble = "/ensembles/([0-9a-f-]{36})";
+
 constexpr std::array<Method, 5> all_methods{Method::get, Method::post, Method::put, Method::patch,
                                             Method::del};
 
@@ -41,6 +44,14 @@ std::vector<Route> route_table() {
       {Method::get, job + "/results", Access::token, get_manifest},
       {Method::get, job + "/results/(.+)", Access::token, get_result_file},
       {Method::get, job + "/events", Access::token, stream_events},
+      // Ensembles (contract v3, ensembles.cpp); their samples are /jobs.
+      {Method::post, "/ensembles", Access::token, post_ensemble},
+      {Method::get, "/ensembles", Access::token, list_ensembles, {"status", "limit"}},
+      {Method::get, ensemble, Access::token, get_ensemble},
+      {Method::del, ensemble, Access::token, delete_ensemble},
+      {Method::post, ensemble + "/cancel", Access::token, cancel_ensemble},
+      {Method::get, ensemble + "/results", Access::token, get_ensemble_manifest},
+      {Method::get, ensemble + "/results/(.+)", Access::token, get_ensemble_file},
       {Method::get, "/fields", Access::open, get_fields},
       {Method::get, "/ui(/.*)?", Access::open, get_ui},
       // OGC API – Processes (ogc.cpp); its jobs are the /jobs routes above.

@@ -111,6 +111,10 @@ struct JobRecord {
   /// Dismissed by deletion (DELETE): its files are gone. A job dismissed by
   /// cancellation keeps whatever it wrote (false).
   bool results_deleted = false;
+  /// A sample of an ensemble: the ensemble's id and the sample's index
+  /// (empty and -1 for a job submitted on its own).
+  std::string ensemble_id;
+  int ensemble_index = -1;
 };
 
 /// A result file of a finished job: `<data-dir>/<job id>/<name>`.
@@ -141,6 +145,74 @@ struct SubmitResult {
   SubmitOutcome outcome = SubmitOutcome::created;
   JobRecord job;
 };
+
+/// What the client did to an ensemble; its status is derived from its
+/// samples' (ensembles/ensemble.hpp).
+enum class EnsembleState {
+  active,     ///< as submitted
+  cancelled,  ///< POST /ensembles/{id}/cancel: its unfinished samples were cancelled
+  deleted,    ///< DELETE /ensembles/{id}: its samples were deleted
+};
+
+/// A new ensemble (contract v3): its request, and its samples as ordinary
+/// jobs, sample k at samples[k].
+struct NewEnsemble {
+  std::string id;
+  std::string request;  ///< the POST /ensembles body as JSON text
+  std::int64_t seed = 0;
+  std::vector<NewJob> samples;
+  std::string idempotency_key;  ///< empty: none
+  std::string body_sha256;      ///< hash of the request body, for the key check
+};
+
+/// One sample of an ensemble, as the ensemble's documents need it.
+struct EnsembleSample {
+  int index = 0;
+  std::string job_id;
+  JobStatus status = JobStatus::accepted;
+  double progress = 0.0;  ///< percent
+  int attempts = 0;
+  bool results_deleted = false;
+};
+
+/// One row of the ensembles table with its samples (index order; a sample
+/// forgotten by retention is missing).
+struct EnsembleRecord {
+  std::string id;
+  std::int64_t seq = 0;
+  std::string request;
+  std::int64_t seed = 0;
+  int samples = 0;  ///< how many were submitted
+  EnsembleState state = EnsembleState::active;
+  std::string created;
+  std::string updated;
+  std::vector<EnsembleSample> jobs;
+};
+
+struct EnsembleSubmitResult {
+  SubmitOutcome outcome = SubmitOutcome::created;  ///< as for a job
+  EnsembleRecord ensemble;
+};
+
+/// "active", "cancelled", "deleted" (as stored).
+inline const char* ensemble_state_name(EnsembleState state) {
+  switch (state) {
+    case EnsembleState::cancelled:
+      return "cancelled";
+    case EnsembleState::deleted:
+      return "deleted";
+    case EnsembleState::active:
+      break;
+  }
+  return "active";
+}
+
+/// Inverse of ensemble_state_name (anything else: active).
+inline EnsembleState parse_ensemble_state(std::string_view text) {
+  if (text == "cancelled") return EnsembleState::cancelled;
+  if (text == "deleted") return EnsembleState::deleted;
+  return EnsembleState::active;
+}
 
 /// recover(): how many starts, in units of max_attempts, a job may have
 /// without a charged crash before it fails anyway.
@@ -291,6 +363,7 @@ class JobStore {
   /// rows and idempotency key, and returns the ids in submission order; the
   /// caller removes their folders. Accepted and running jobs are never
   /// purged, however old. A purged id is unknown from then on (find: nullopt).
+  /// An ensemble goes with its last sample.
   virtual std::vector<std::string> purge_ended(
       std::chrono::system_clock::time_point ended_before) = 0;
 
@@ -301,6 +374,24 @@ class JobStore {
   virtual ClaimState record_checkpoint(const Claim& claim, const CheckpointRecord& checkpoint) = 0;
   /// The job's last recorded checkpoint, if any (cleared when the job ends).
   virtual std::optional<CheckpointRecord> checkpoint(const std::string& id) = 0;
+
+  /// Stores an ensemble and all its samples as accepted jobs in one
+  /// transaction: all or nothing, so a crash never leaves half an ensemble.
+  /// Refused (queue_full, nothing stored) when the accepted jobs and the
+  /// samples together would exceed `max_queue`; an idempotency key used
+  /// before gives back that ensemble (replayed or key_conflict) as submit does.
+  virtual EnsembleSubmitResult submit_ensemble(const NewEnsemble& ensemble,
+                                               std::int64_t max_queue) = 0;
+  /// The ensemble with its samples; nullopt for an unknown id.
+  virtual std::optional<EnsembleRecord> find_ensemble(const std::string& id) = 0;
+  /// Newest first, each with its samples.
+  virtual std::vector<EnsembleRecord> list_ensembles(int limit) = 0;
+  /// Records what the client did (cancelled, deleted); deleted stays deleted
+  /// (a cancel after it changes nothing). Returns the row as it was before;
+  /// nullopt for an unknown id. The samples are cancelled or dismissed by
+  /// the caller, one by one, with cancel() and dismiss().
+  virtual std::optional<EnsembleRecord> set_ensemble_state(const std::string& id,
+                                                           EnsembleState state) = 0;
 };
 
 /// Opens (creating if needed) the SQLite database at `db_path` for this

@@ -39,7 +39,7 @@ const std::string job_columns =
     "cost_nodes, cost_cells, cost_steps, cost_particle_steps, cost_memory_bytes, "
     "cost_output_bytes, cost_dt, run_seconds, coalesce(owner, ''), lease_token, "
     "lease_expires_ms, results_deleted, run_time, run_end_time, run_steps, run_dt_min, "
-    "run_dt_max, CASE WHEN jobs.status = " +
+    "run_dt_max, coalesce(ensemble_id, ''), ensemble_index, CASE WHEN jobs.status = " +
     sql_name(JobStatus::accepted) +
     " THEN 1 + (SELECT count(*) FROM jobs AS ahead WHERE ahead.status = " +
     sql_name(JobStatus::accepted) + " AND ahead.seq < jobs.seq) ELSE 0 END";
@@ -89,6 +89,8 @@ JobRecord read_job(const Result& r, int row) {
   job.run.steps = integer();
   job.run.dt_min = real();
   job.run.dt_max = real();
+  job.ensemble_id = text();
+  job.ensemble_index = static_cast<int>(integer());
   job.queue_position = integer();
   return job;
 }
@@ -140,6 +142,70 @@ void replace_results(PGconn* db, const std::string& id, const std::vector<Result
   }
 }
 
+// Inserts `job` as accepted (sample `index` of ensemble `ensemble` when
+// that is not empty), created at `now`; returns the new row.
+Result insert_job(PGconn* db, const NewJob& job, const std::string& now,
+                  const std::string& ensemble = "", int index = -1) {
+  Params p;
+  p.add(job.id).add(job.name).add(job.spec).add(now);
+  p.add_or_null(job.idempotency_key).add_or_null(job.body_sha256);
+  p.add(job.cost.particles).add(job.cost.nodes).add(job.cost.cells).add(job.cost.steps);
+  p.add(job.cost.particle_steps).add(job.cost.memory_bytes).add(job.cost.output_bytes);
+  p.add(job.cost.dt).add_or_null(ensemble).add(std::int64_t{index});
+  return exec(db,
+              "INSERT INTO jobs (id, name, spec, status, message, created, updated, "
+              "idempotency_key, body_sha256, cost_particles, cost_nodes, cost_cells, cost_steps, "
+              "cost_particle_steps, cost_memory_bytes, cost_output_bytes, cost_dt, ensemble_id, "
+              "ensemble_index) VALUES ($1, $2, $3, " +
+                  sql_name(JobStatus::accepted) +
+                  ", 'queued', $4, $4, $5, $6, $7, $8, $9, $10, $11, $12, $13, $14, $15, $16) "
+                  "RETURNING " +
+                  job_columns,
+              p);
+}
+
+const char* const ensemble_columns =
+    "id, seq, request, seed, samples, state, created, updated FROM ensembles";
+
+EnsembleRecord read_ensemble(const Result& r, int row) {
+  EnsembleRecord e;
+  e.id = r.text(row, 0);
+  e.seq = r.integer(row, 1);
+  e.request = r.text(row, 2);
+  e.seed = r.integer(row, 3);
+  e.samples = static_cast<int>(r.integer(row, 4));
+  e.state = parse_ensemble_state(r.text(row, 5));
+  e.created = r.text(row, 6);
+  e.updated = r.text(row, 7);
+  return e;
+}
+
+// Fills e.jobs from the jobs table.
+void read_samples(PGconn* db, EnsembleRecord& e) {
+  const Result r = exec(db,
+                        "SELECT ensemble_index, id, status, progress, attempts, results_deleted "
+                        "FROM jobs WHERE ensemble_id = $1 ORDER BY ensemble_index",
+                        Params().add(e.id));
+  e.jobs.reserve(static_cast<std::size_t>(r.rows()));
+  for (int i = 0; i < r.rows(); ++i) {
+    e.jobs.push_back({static_cast<int>(r.integer(i, 0)), r.text(i, 1),
+                      parse_status(r.text(i, 2)).value_or(JobStatus::failed), r.real(i, 3),
+                      static_cast<int>(r.integer(i, 4)), r.boolean(i, 5)});
+  }
+}
+
+std::optional<EnsembleRecord> select_ensemble(PGconn* db, const std::string& id,
+                                              bool for_update = false) {
+  const Result r = exec(db,
+                        std::string("SELECT ") + ensemble_columns + " WHERE id = $1" +
+                            (for_update ? " FOR UPDATE" : ""),
+                        Params().add(id));
+  if (r.rows() == 0) return std::nullopt;
+  EnsembleRecord e = read_ensemble(r, 0);
+  read_samples(db, e);
+  return e;
+}
+
 }  // namespace
 
 std::chrono::system_clock::time_point PostgresStore::now() const {
@@ -189,22 +255,7 @@ SubmitResult PostgresStore::submit(const NewJob& job, std::int64_t max_queue) {
           .integer(0, 0) >= max_queue) {
     return {SubmitOutcome::queue_full, {}};
   }
-  Params p;
-  p.add(job.id).add(job.name).add(job.spec).add(now_text());
-  p.add_or_null(job.idempotency_key).add_or_null(job.body_sha256);
-  p.add(job.cost.particles).add(job.cost.nodes).add(job.cost.cells).add(job.cost.steps);
-  p.add(job.cost.particle_steps).add(job.cost.memory_bytes).add(job.cost.output_bytes);
-  p.add(job.cost.dt);
-  const Result r =
-      exec(db,
-           "INSERT INTO jobs (id, name, spec, status, message, created, updated, idempotency_key, "
-           "body_sha256, cost_particles, cost_nodes, cost_cells, cost_steps, cost_particle_steps, "
-           "cost_memory_bytes, cost_output_bytes, cost_dt) VALUES ($1, $2, $3, " +
-               sql_name(JobStatus::accepted) +
-               ", 'queued', $4, $4, $5, $6, $7, $8, $9, $10, $11, $12, $13, $14) RETURNING " +
-               job_columns,
-           p);
-  JobRecord created = read_job(r, 0);
+  JobRecord created = read_job(insert_job(db, job, now_text()), 0);
   tx.commit();
   return {SubmitOutcome::created, std::move(created)};
 }
@@ -477,6 +528,11 @@ std::vector<std::string> PostgresStore::purge_ended(
   std::vector<std::string> ids;
   ids.reserve(static_cast<std::size_t>(r.rows()));
   for (int i = 0; i < r.rows(); ++i) ids.push_back(r.text(i, 0));
+  // An ensemble is stored with its samples in one transaction, so one
+  // without any is one whose samples were all purged.
+  exec(db.get(),
+       "DELETE FROM ensembles WHERE NOT EXISTS (SELECT 1 FROM jobs WHERE jobs.ensemble_id = "
+       "ensembles.id)");
   return ids;
 }
 
@@ -507,6 +563,79 @@ std::optional<CheckpointRecord> PostgresStore::checkpoint(const std::string& id)
   if (r.rows() == 0) return std::nullopt;
   return CheckpointRecord{r.text(0, 0),    r.integer(0, 1), r.real(0, 2),
                           r.integer(0, 3), r.text(0, 4),    r.text(0, 5)};
+}
+
+EnsembleSubmitResult PostgresStore::submit_ensemble(const NewEnsemble& ensemble,
+                                                    std::int64_t max_queue) {
+  auto connection = pool_.lease();
+  PGconn* db = connection.get();
+  Transaction tx(db);
+  exec(db, submit_lock);
+  if (!ensemble.idempotency_key.empty()) {
+    const Result r = exec(db, "SELECT id, body_sha256 FROM ensembles WHERE idempotency_key = $1",
+                          Params().add(ensemble.idempotency_key));
+    if (r.rows() > 0) {
+      const bool same_body = r.text(0, 1) == ensemble.body_sha256;
+      auto earlier = select_ensemble(db, r.text(0, 0));
+      tx.commit();
+      return {same_body ? SubmitOutcome::replayed : SubmitOutcome::key_conflict,
+              std::move(*earlier)};
+    }
+  }
+  if (exec(db, "SELECT count(*) FROM jobs WHERE status = " + sql_name(JobStatus::accepted))
+              .integer(0, 0) +
+          static_cast<std::int64_t>(ensemble.samples.size()) >
+      max_queue) {
+    return {SubmitOutcome::queue_full, {}};
+  }
+  const std::string now = now_text();
+  exec(db,
+       "INSERT INTO ensembles (id, request, seed, samples, created, updated, idempotency_key, "
+       "body_sha256) VALUES ($1, $2, $3, $4, $5, $5, $6, $7)",
+       Params()
+           .add(ensemble.id)
+           .add(ensemble.request)
+           .add(ensemble.seed)
+           .add(static_cast<std::int64_t>(ensemble.samples.size()))
+           .add(now)
+           .add_or_null(ensemble.idempotency_key)
+           .add_or_null(ensemble.body_sha256));
+  for (std::size_t k = 0; k < ensemble.samples.size(); ++k)
+    insert_job(db, ensemble.samples[k], now, ensemble.id, static_cast<int>(k));
+  auto created = select_ensemble(db, ensemble.id);
+  tx.commit();
+  return {SubmitOutcome::created, std::move(*created)};
+}
+
+std::optional<EnsembleRecord> PostgresStore::find_ensemble(const std::string& id) {
+  auto db = pool_.lease();
+  return select_ensemble(db.get(), id);
+}
+
+std::vector<EnsembleRecord> PostgresStore::list_ensembles(int limit) {
+  auto connection = pool_.lease();
+  PGconn* db = connection.get();
+  const Result r =
+      exec(db, std::string("SELECT ") + ensemble_columns + " ORDER BY seq DESC LIMIT $1",
+           Params().add(std::int64_t{limit}));
+  std::vector<EnsembleRecord> out;
+  out.reserve(static_cast<std::size_t>(r.rows()));
+  for (int i = 0; i < r.rows(); ++i) out.push_back(read_ensemble(r, i));
+  for (EnsembleRecord& e : out) read_samples(db, e);
+  return out;
+}
+
+std::optional<EnsembleRecord> PostgresStore::set_ensemble_state(const std::string& id,
+                                                                EnsembleState state) {
+  auto connection = pool_.lease();
+  PGconn* db = connection.get();
+  Transaction tx(db);
+  auto before = select_ensemble(db, id, true);
+  if (!before || before->state == EnsembleState::deleted) return before;
+  exec(db, "UPDATE ensembles SET state = $2, updated = $3 WHERE id = $1",
+       Params().add(id).add(ensemble_state_name(state)).add(now_text()));
+  tx.commit();
+  return before;
 }
 
 }  // namespace hmpm::server::postgres

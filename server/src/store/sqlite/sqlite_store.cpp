@@ -32,7 +32,8 @@ const std::string job_columns =
     "attempts, failure_reason, cost_particles, cost_nodes, cost_cells, cost_steps, "
     "cost_particle_steps, cost_memory_bytes, cost_output_bytes, cost_dt, run_seconds, "
     "coalesce(owner, ''), lease_token, lease_expires_ms, results_deleted, run_time, "
-    "run_end_time, run_steps, run_dt_min, run_dt_max, CASE WHEN status = " +
+    "run_end_time, run_steps, run_dt_min, run_dt_max, coalesce(ensemble_id, ''), "
+    "ensemble_index, CASE WHEN status = " +
     sql_name(JobStatus::accepted) +
     " THEN 1 + (SELECT count(*) FROM jobs AS ahead WHERE ahead.status = " +
     sql_name(JobStatus::accepted) + " AND ahead.seq < jobs.seq) ELSE 0 END";
@@ -71,7 +72,9 @@ JobRecord read_job(const Statement& s) {
   r.run.steps = s.integer(28);
   r.run.dt_min = s.real(29);
   r.run.dt_max = s.real(30);
-  r.queue_position = s.integer(31);
+  r.ensemble_id = s.text(31);
+  r.ensemble_index = static_cast<int>(s.integer(32));
+  r.queue_position = s.integer(33);
   return r;
 }
 
@@ -117,6 +120,64 @@ void insert_results(sqlite3* db, const std::string& id, const std::vector<Result
     s.bind(1, id).bind(2, f.name).bind(3, f.size).bind(4, f.sha256).bind(5, f.media_type);
     s.step();
   }
+}
+
+// Inserts `job` as accepted (sample `index` of ensemble `ensemble` when
+// that is not empty), created at `now`.
+void insert_job(sqlite3* db, const NewJob& job, const std::string& now,
+                const std::string& ensemble = "", int index = -1) {
+  Statement s(
+      db,
+      "INSERT INTO jobs (id, name, spec, status, message, created, updated, idempotency_key, "
+      "body_sha256, cost_particles, cost_nodes, cost_cells, cost_steps, cost_particle_steps, "
+      "cost_memory_bytes, cost_output_bytes, cost_dt, ensemble_id, ensemble_index) VALUES (?1, "
+      "?2, ?3, ?15, 'queued', ?4, ?4, ?5, ?6, ?7, ?8, ?9, ?10, ?11, ?12, ?13, ?14, ?16, ?17)");
+  s.bind(1, job.id).bind(2, job.name).bind(3, job.spec).bind(4, now);
+  s.bind_or_null(5, job.idempotency_key).bind_or_null(6, job.body_sha256);
+  s.bind(7, job.cost.particles).bind(8, job.cost.nodes).bind(9, job.cost.cells);
+  s.bind(10, job.cost.steps).bind(11, job.cost.particle_steps).bind(12, job.cost.memory_bytes);
+  s.bind(13, job.cost.output_bytes).bind(14, job.cost.dt);
+  s.bind(15, status_name(JobStatus::accepted));
+  s.bind_or_null(16, ensemble).bind(17, static_cast<std::int64_t>(index));
+  s.step();
+}
+
+const char* const ensemble_columns =
+    "id, seq, request, seed, samples, state, created, updated FROM ensembles";
+
+EnsembleRecord read_ensemble(const Statement& s) {
+  EnsembleRecord e;
+  e.id = s.text(0);
+  e.seq = s.integer(1);
+  e.request = s.text(2);
+  e.seed = s.integer(3);
+  e.samples = static_cast<int>(s.integer(4));
+  e.state = parse_ensemble_state(s.text(5));
+  e.created = s.text(6);
+  e.updated = s.text(7);
+  return e;
+}
+
+// Fills e.jobs from the jobs table.
+void read_samples(sqlite3* db, EnsembleRecord& e) {
+  Statement s(db,
+              "SELECT ensemble_index, id, status, progress, attempts, results_deleted FROM jobs "
+              "WHERE ensemble_id = ?1 ORDER BY ensemble_index");
+  s.bind(1, e.id);
+  while (s.step()) {
+    e.jobs.push_back({static_cast<int>(s.integer(0)), s.text(1),
+                      parse_status(s.text(2)).value_or(JobStatus::failed), s.real(3),
+                      static_cast<int>(s.integer(4)), s.integer(5) != 0});
+  }
+}
+
+std::optional<EnsembleRecord> select_ensemble(sqlite3* db, const std::string& id) {
+  Statement s(db, std::string("SELECT ") + ensemble_columns + " WHERE id = ?1");
+  s.bind(1, id);
+  if (!s.step()) return std::nullopt;
+  EnsembleRecord e = read_ensemble(s);
+  read_samples(db, e);
+  return e;
 }
 
 }  // namespace
@@ -259,20 +320,7 @@ SubmitResult SqliteStore::submit(const NewJob& job, std::int64_t max_queue) {
     Statement s(db, "SELECT count(*) FROM jobs WHERE status = " + sql_name(JobStatus::accepted));
     if (s.step() && s.integer(0) >= max_queue) return {SubmitOutcome::queue_full, {}};
   }
-  const std::string now = now_text();
-  Statement s(
-      db,
-      "INSERT INTO jobs (id, name, spec, status, message, created, updated, idempotency_key, "
-      "body_sha256, cost_particles, cost_nodes, cost_cells, cost_steps, cost_particle_steps, "
-      "cost_memory_bytes, cost_output_bytes, cost_dt) VALUES (?1, ?2, ?3, ?15, "
-      "'queued', ?4, ?4, ?5, ?6, ?7, ?8, ?9, ?10, ?11, ?12, ?13, ?14)");
-  s.bind(1, job.id).bind(2, job.name).bind(3, job.spec).bind(4, now);
-  s.bind_or_null(5, job.idempotency_key).bind_or_null(6, job.body_sha256);
-  s.bind(7, job.cost.particles).bind(8, job.cost.nodes).bind(9, job.cost.cells);
-  s.bind(10, job.cost.steps).bind(11, job.cost.particle_steps).bind(12, job.cost.memory_bytes);
-  s.bind(13, job.cost.output_bytes).bind(14, job.cost.dt);
-  s.bind(15, status_name(JobStatus::accepted));
-  s.step();
+  insert_job(db, job, now_text());
   auto created = select_job(db, job.id);
   tx.commit();
   return {SubmitOutcome::created, std::move(*created)};
@@ -560,6 +608,9 @@ std::vector<std::string> SqliteStore::purge_ended(
   Statement s(db, "DELETE FROM jobs WHERE " + ended);
   s.bind(1, cutoff);
   s.step();
+  exec(db,
+       "DELETE FROM ensembles WHERE NOT EXISTS (SELECT 1 FROM jobs WHERE jobs.ensemble_id = "
+       "ensembles.id)");
   tx.commit();
   return ids;
 }
@@ -593,6 +644,74 @@ std::optional<CheckpointRecord> SqliteStore::checkpoint(const std::string& id) {
   s.bind(1, id);
   if (!s.step()) return std::nullopt;
   return CheckpointRecord{s.text(0), s.integer(1), s.real(2), s.integer(3), s.text(4), s.text(5)};
+}
+
+EnsembleSubmitResult SqliteStore::submit_ensemble(const NewEnsemble& ensemble,
+                                                  std::int64_t max_queue) {
+  auto connection = pool_.lease();
+  sqlite3* db = connection.get();
+  WriteTransaction tx(db);
+  if (!ensemble.idempotency_key.empty()) {
+    Statement s(db, "SELECT id, body_sha256 FROM ensembles WHERE idempotency_key = ?1");
+    s.bind(1, ensemble.idempotency_key);
+    if (s.step()) {
+      const bool same_body = s.text(1) == ensemble.body_sha256;
+      auto earlier = select_ensemble(db, s.text(0));
+      tx.commit();
+      return {same_body ? SubmitOutcome::replayed : SubmitOutcome::key_conflict,
+              std::move(*earlier)};
+    }
+  }
+  {
+    Statement s(db, "SELECT count(*) FROM jobs WHERE status = " + sql_name(JobStatus::accepted));
+    if (s.step() && s.integer(0) + static_cast<std::int64_t>(ensemble.samples.size()) > max_queue)
+      return {SubmitOutcome::queue_full, {}};
+  }
+  const std::string now = now_text();
+  {
+    Statement s(db,
+                "INSERT INTO ensembles (id, request, seed, samples, created, updated, "
+                "idempotency_key, body_sha256) VALUES (?1, ?2, ?3, ?4, ?5, ?5, ?6, ?7)");
+    s.bind(1, ensemble.id).bind(2, ensemble.request).bind(3, ensemble.seed);
+    s.bind(4, static_cast<std::int64_t>(ensemble.samples.size())).bind(5, now);
+    s.bind_or_null(6, ensemble.idempotency_key).bind_or_null(7, ensemble.body_sha256);
+    s.step();
+  }
+  for (std::size_t k = 0; k < ensemble.samples.size(); ++k)
+    insert_job(db, ensemble.samples[k], now, ensemble.id, static_cast<int>(k));
+  auto created = select_ensemble(db, ensemble.id);
+  tx.commit();
+  return {SubmitOutcome::created, std::move(*created)};
+}
+
+std::optional<EnsembleRecord> SqliteStore::find_ensemble(const std::string& id) {
+  auto db = pool_.lease();
+  return select_ensemble(db.get(), id);
+}
+
+std::vector<EnsembleRecord> SqliteStore::list_ensembles(int limit) {
+  auto connection = pool_.lease();
+  sqlite3* db = connection.get();
+  Statement s(db, std::string("SELECT ") + ensemble_columns + " ORDER BY seq DESC LIMIT ?1");
+  s.bind(1, static_cast<std::int64_t>(limit));
+  std::vector<EnsembleRecord> out;
+  while (s.step()) out.push_back(read_ensemble(s));
+  for (EnsembleRecord& e : out) read_samples(db, e);
+  return out;
+}
+
+std::optional<EnsembleRecord> SqliteStore::set_ensemble_state(const std::string& id,
+                                                              EnsembleState state) {
+  auto connection = pool_.lease();
+  sqlite3* db = connection.get();
+  WriteTransaction tx(db);
+  auto before = select_ensemble(db, id);
+  if (!before || before->state == EnsembleState::deleted) return before;
+  Statement s(db, "UPDATE ensembles SET state = ?2, updated = ?3 WHERE id = ?1");
+  s.bind(1, id).bind(2, ensemble_state_name(state)).bind(3, now_text());
+  s.step();
+  tx.commit();
+  return before;
 }
 
 }  // namespace hmpm::server::sqlite

@@ -46,6 +46,12 @@ class SqliteStore final : public JobStore {
   std::vector<std::string> purge_ended(std::chrono::system_clock::time_point ended_before) override;
   ClaimState record_checkpoint(const Claim& claim, const CheckpointRecord& checkpoint) override;
   std::optional<CheckpointRecord> checkpoint(const std::string& id) override;
+  EnsembleSubmitResult submit_ensemble(const NewEnsemble& ensemble,
+                                       std::int64_t max_queue) override;
+  std::optional<EnsembleRecord> find_ensemble(const std::string& id) override;
+  std::vector<EnsembleRecord> list_ensembles(int limit) override;
+  std::optional<EnsembleRecord> set_ensemble_state(const std::string& id,
+                                                   EnsembleState state) override;
 
  private:
   std::chrono::system_clock::time_point now() const;

@@ -1,0 +1,20 @@
+-- 0008: ensembles (contract v3, POST /ensembles): the request as submitted,
+-- its seed and what the client did to it (state); the samples are ordinary
+-- jobs that name their ensemble and their index in it. Stored with its
+-- samples in one transaction. An ensemble goes when retention has purged
+-- its last sample.
+CREATE TABLE ensembles (
+  seq INTEGER PRIMARY KEY AUTOINCREMENT,
+  id TEXT NOT NULL UNIQUE,
+  request TEXT NOT NULL,
+  seed INTEGER NOT NULL,
+  samples INTEGER NOT NULL,
+  state TEXT NOT NULL DEFAULT 'active' CHECK (state IN ('active','cancelled','deleted')),
+  created TEXT NOT NULL,
+  updated TEXT NOT NULL,
+  idempotency_key TEXT UNIQUE,
+  body_sha256 TEXT
+);
+ALTER TABLE jobs ADD COLUMN ensemble_id TEXT;
+ALTER TABLE jobs ADD COLUMN ensemble_index INTEGER NOT NULL DEFAULT -1;
+CREATE INDEX jobs_by_ensemble ON jobs (ensemble_id, ensemble_index) WHERE ensemble_id IS NOT NULL;
