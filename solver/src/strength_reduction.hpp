@@ -80,7 +80,8 @@ void Simulation<Dim, Shape>::reduce_strength(RunResult& result, double t,
     const double next = std::min(f + step, sr.max_factor);
     reduced.clear();
     for (const Material& m : model_.problem.materials)
-      reduced.push_back(material_constants(reduced_strength(m, next), model_.problem.gravity_constant));
+      reduced.push_back(
+          material_constants(reduced_strength(m, next), model_.problem.gravity_constant));
     ++out.attempts;
     if (scheme.strength_reduce(reduced, t)) {
       f = next;
@@ -98,8 +99,8 @@ void Simulation<Dim, Shape>::reduce_strength(RunResult& result, double t,
                     ? "strength reduction: the soil is in equilibrium up to F = " + number(f) +
                           " (strength_reduction.max_factor): the factor of safety is at least that"
                     : "strength reduction: factor of safety F = " + number(f) +
-                          " (converged at F = " + number(f) + ", not at F = " +
-                          number(out.failed_at) + " within " +
+                          " (converged at F = " + number(f) +
+                          ", not at F = " + number(out.failed_at) + " within " +
                           std::to_string(model_.problem.time.implicit.max_iterations) +
                           " Newton iterations; largest displacement since F = 1: " +
                           number(out.max_displacement.back()) + " m)";

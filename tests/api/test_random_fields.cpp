@@ -95,7 +95,7 @@ double lag_sum(int n, double d, F&& f) {
 TEST(RandomFields, GeneratedFieldHasTheTargetStatistics) {
   const std::vector<double> e = generated(42);
   const int per_axis = cells * ppc;
-  const auto n = static_cast<std::size_t>(per_axis * per_axis);
+  const auto n = static_cast<std::size_t>(per_axis) * static_cast<std::size_t>(per_axis);
   ASSERT_EQ(e.size(), n);
   const double d = side / per_axis;
   const double s2 = std::log(1 + cov_e * cov_e), mu = std::log(mean_e) - s2 / 2;
@@ -135,9 +135,15 @@ TEST(RandomFields, GeneratedFieldHasTheTargetStatistics) {
   for (int y = 0; y < per_axis; ++y)
     for (int x = 0; x + 1 < per_axis; ++x) {
       const double a =
-          (std::log(e[static_cast<std::size_t>(y * per_axis + x)]) - mu) / std::sqrt(s2);
+          (std::log(e[(static_cast<std::size_t>(y) * static_cast<std::size_t>(per_axis)) +
+                      static_cast<std::size_t>(x)]) -
+           mu) /
+          std::sqrt(s2);
       const double b =
-          (std::log(e[static_cast<std::size_t>(y * per_axis + x + 1)]) - mu) / std::sqrt(s2);
+          (std::log(e[(static_cast<std::size_t>(y) * static_cast<std::size_t>(per_axis)) +
+                      static_cast<std::size_t>(x) + 1]) -
+           mu) /
+          std::sqrt(s2);
       c += a * b;
       v0 += a * a;
     }

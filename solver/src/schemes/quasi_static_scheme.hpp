@@ -192,7 +192,7 @@ class QuasiStaticScheme final : public TimeScheme {
       h = 0.5 * hh;
       // A crawl: cut-backs in a row without a step that converged at its
       // first length (in this call or a step before).
-      if (++crawl_ >= 4 * std::max(1, c.max_cutbacks) && c_.model.plastic &&
+      if (++crawl_ >= 4L * std::max(1, c.max_cutbacks) && c_.model.plastic &&
           !c_.failures.collapse.found) {
         collapse(t_cur, "cutbacks_in_a_row", crawl_, h);
         if (c_.failures.failed) return;
