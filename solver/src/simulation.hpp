@@ -52,6 +52,7 @@
 #include "boundary/constraints.hpp"
 #include "boundary/surface_pressures.hpp"
 #include "boundary/tractions.hpp"
+#include "collapse_watch.hpp"
 #include "failures.hpp"
 #include "hmpm/problem.hpp"
 #include "hmpm/run.hpp"
@@ -255,6 +256,9 @@ class Simulation {
   /// Problem::strength_reduction from the state at time t
   /// (strength_reduction.hpp): the factor of safety into `result`.
   void reduce_strength(RunResult& result, double t, const RunOptions& options);
+  /// A collapse the explicit and semi-implicit schemes follow, if `w`
+  /// finds one at time t (time_loop.hpp): true when the run stops there.
+  bool report_dynamic_collapse(CollapseWatch<Dim>& w, double t);
 
   // ------------------------------------------------------------ output (output.hpp)
   void fill_snapshot(Snapshot& snap, const std::vector<Field>& fields) const;

@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "checkpoint.hpp"
+#include "collapse_watch.hpp"
 #include "output.hpp"
 #include "run_watch.hpp"
 #include "schemes/make_scheme.hpp"
@@ -360,6 +361,9 @@ RunResult Simulation<Dim, Shape>::run(const RunOptions& options) {
     RunWatch<Dim> watch(model_.problem, model_.constants);
     const std::int64_t watch_stride = std::max<std::int64_t>(1, steps / 500);
     std::int64_t watched = -1;  // the step count at the last check
+    // A collapse the explicit and semi-implicit schemes follow
+    // (collapse_watch.hpp), checked as often.
+    CollapseWatch<Dim> collapse_watch(model_.problem, particles_);
 
     for (; fixed ? j < steps : t < stage_end; ++n, ++j) {
       if (options.cancel && options.cancel->load(std::memory_order_relaxed)) {
@@ -410,6 +414,14 @@ RunResult Simulation<Dim, Shape>::run(const RunOptions& options) {
       if (watch.active() && (j + 1) % watch_stride == 0) {
         watch.check(particles_, t);
         watched = j + 1;
+      }
+      if (collapse_watch.active() && (j + 1) % watch_stride == 0 && !failures_.collapse.found &&
+          report_dynamic_collapse(collapse_watch, t)) {
+        result.status = RunStatus::failed;
+        result.message = stage_text() + "step " + std::to_string(n + 1) + " (t = " + number(t) +
+                         " s): " + failures_.what + ". What to change: " + failures_.hint + ".";
+        ++n;
+        break;
       }
       if (want_series && (out.series_interval <= 0 || t >= next_series - eps_t)) {
         sample_series(series, t);
@@ -511,9 +523,47 @@ RunResult Simulation<Dim, Shape>::run(const RunOptions& options) {
     if (stages > 1) result.message.append(" in ").append(std::to_string(stages)).append(" stages");
     if (result.strength_reduction.done)
       result.message.append("; ").append(result.strength_reduction.message);
+    if (result.collapse.found)
+      result.message.append("; the soil collapsed at t = ")
+          .append(number(result.collapse.time))
+          .append(" s (")
+          .append(result.collapse.criterion)
+          .append(", see the warnings)");
   }
   report(n, t);
   return result;
+}
+
+/// A dynamic collapse found by `w` at time t (collapse_watch.hpp): its
+/// load and message into failures_.collapse; true when the run stops there
+/// (time.on_collapse 'stop', fail_run), false when it goes on (a warning).
+template <int Dim, class Shape>
+bool Simulation<Dim, Shape>::report_dynamic_collapse(CollapseWatch<Dim>& w, double t) {
+  RunResult::Collapse& k = failures_.collapse;
+  if (!w.check(particles_, t, k)) return false;
+  k.load = traction_resultant(model_.tractions, particles_, t);
+  auto text = [](const Vec3& v) {
+    std::string s = "(";
+    for (int a = 0; a < Dim; ++a) s += (a ? ", " : "") + number(v[static_cast<std::size_t>(a)]);
+    return s + ")";
+  };
+  std::ostringstream what;
+  what << "the soil collapses: at t = " << number(t) << " s a particle that yielded has moved "
+       << number(w.worst()) << " m in the stage, more than "
+       << static_cast<int>(collapse_fraction * 100) << " % of the soil's height ("
+       << number(w.height()) << " m): a mechanism; surface loads " << text(k.load) << " N";
+  if (Dim < 3) what << (Dim == 2 ? "/m" : "/m^2");
+  what << ", largest displacement " << number(k.max_displacement) << " m, " << k.yielding
+       << " particles yielding";
+  if (k.yielding > 0) what << " in " << text(k.yield_min) << " .. " << text(k.yield_max);
+  k.message = what.str();
+  k.stopped = collapse_action(model_.problem.time) == CollapseAction::stop;
+  if (k.stopped)
+    failures_.fail_run(k.message,
+                       "strengthen the soil or lower the loads if it should stand; to follow the "
+                       "run-out, set time.on_collapse to 'continue' (the default of the explicit "
+                       "and semi-implicit schemes)");
+  return k.stopped;
 }
 
 }  // namespace hmpm

@@ -144,6 +144,27 @@ inline void for_face_nodes(const FaceParticles& face, std::size_t k,
   for (int n = 0; n < StencilT::N; ++n) add(s.node[n], s.w[n] * whole);
 }
 
+/// The resultant of the surface loads at time t, N (per metre in 2D), on
+/// the faces' current areas (the explicit schemes' follower loads): the
+/// load level a collapse report gives (collapse_watch.hpp).
+template <int Dim>
+inline Vec3 traction_resultant(const std::vector<TractionLoad>& tractions,
+                               const ParticleState<Dim>& particles, double t) {
+  Vec3 sum{0.0, 0.0, 0.0};
+  for (const TractionLoad& load : tractions)
+    for (std::size_t k = 0; k < load.particles.size(); ++k) {
+      const auto p = static_cast<std::size_t>(load.particles[k]);
+      const double area = particles.volume[p] / load.length0[k];
+      for (int a = 0; a < Dim; ++a) {
+        double v = load.source->traction[a] ? load.source->traction[a](t) : 0.0;
+        if (!load.x0.empty() && load.source->traction_field[a])
+          v = load.source->traction_field[a](load.x0[k], t);
+        sum[static_cast<std::size_t>(a)] += v * area;
+      }
+    }
+  return sum;
+}
+
 /// Surface loads at time t, mapped at the loaded face of each selected
 /// particle and added to the nodal force (for_face_nodes; DeadLoad: the
 /// quasi-static scheme, whose Terzaghi and Mandel loads are fixed forces).
