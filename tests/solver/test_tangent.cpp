@@ -77,6 +77,7 @@ std::string region(const Voigt& trial, const hmpm::MaterialConstants& mc) {
       for (int i = 0; i < a.count; ++i) name += " " + std::to_string(a.planes[i]);
       return name;
     }
+    case hmpm::Model::modified_cam_clay:  // test_cam_clay_tangent.cpp
     case hmpm::Model::linear_elastic:
       break;
   }

@@ -86,7 +86,8 @@ bool parameter_applies(const Material& m, MaterialParameter k) {
       return m.hydraulic.has_value();
     case MaterialParameter::cohesion:
     case MaterialParameter::friction_angle:
-      return !std::holds_alternative<LinearElastic>(m.plasticity);
+      return std::holds_alternative<MohrCoulomb>(m.plasticity) ||
+             std::holds_alternative<DruckerPrager>(m.plasticity);
   }
   return false;
 }
