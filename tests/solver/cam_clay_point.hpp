@@ -59,7 +59,8 @@ inline double deviatoric(const Voigt& s) {
 struct Point {
   hmpm::MaterialConstants mc;
   Voigt sigma;
-  std::vector<double> slots[2] = {{0.0}, {0.0}};  ///< e, p'c (0: from e0 and OCR)
+  std::array<std::vector<double>, 2> slots{
+      std::vector<double>{0.0}, std::vector<double>{0.0}};  ///< e, p'c (0: from e0 and OCR)
   Voigt eps = Voigt::Zero();
   double volumetric = 0.0;  ///< sum of -tr(de), the logarithmic volumetric strain
 
@@ -69,7 +70,7 @@ struct Point {
   /// The update for increment de without committing it.
   Voigt trial(const Voigt& de, Tangent& d, double* plastic = nullptr) {
     Voigt s = sigma;
-    const double r = hmpm::return_with_tangent(s, de, mc, {slots, 0, false}, d);
+    const double r = hmpm::return_with_tangent(s, de, mc, {slots.data(), 0, false}, d);
     if (plastic) *plastic = r;
     return s;
   }
@@ -97,7 +98,7 @@ struct Point {
       for (int i = 0; i < n; ++i) de(s[i]) += dx(i);
     }
     if (n > 0 && it == 60) return -1;
-    hmpm::return_with_tangent(sigma, de, mc, {slots, 0, true}, d);
+    hmpm::return_with_tangent(sigma, de, mc, {slots.data(), 0, true}, d);
     eps += de;
     volumetric -= de(0) + de(1) + de(2);
     return it;

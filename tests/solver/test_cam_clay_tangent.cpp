@@ -9,9 +9,11 @@
 // non-committing update leaves the state alone.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <random>
+#include <vector>
 
 #include "cam_clay_point.hpp"
 
@@ -124,7 +126,7 @@ TEST(CamClayTangent, ExplicitPathIsBitForBitAndTrialsLeaveTheState) {
     EXPECT_EQ(s.pt.slots[0][0], e);  // commit false: the state stays
     EXPECT_EQ(s.pt.slots[1][0], pc);
     Voigt sig = s.pt.sigma;
-    hmpm::return_to_yield_surface(sig, s.de, s.pt.mc, {s.pt.slots, 0, true});
+    hmpm::return_to_yield_surface(sig, s.de, s.pt.mc, {s.pt.slots.data(), 0, true});
     for (int i = 0; i < 6; ++i) EXPECT_EQ(sig(i), with_tangent(i));
     EXPECT_NE(s.pt.slots[0][0], e);  // committed: e follows the volume change
   }
@@ -137,9 +139,9 @@ TEST(CamClayTangent, ZeroAndTensileMeanStressStayFinite) {
     for (const Voigt& de : {Voigt((Voigt() << -1e-3, -1e-3, -1e-3, 0, 0, 0).finished()),
                             Voigt((Voigt() << 1e-3, 2e-3, -1e-3, 1e-3, 0, 0).finished())}) {
       Voigt sig = pt.sigma;
-      std::vector<double> slots[2] = {{0.0}, {0.0}};
+      std::array<std::vector<double>, 2> slots{std::vector<double>{0.0}, std::vector<double>{0.0}};
       Tangent d;
-      hmpm::return_with_tangent(sig, de, pt.mc, {slots, 0, true}, d);
+      hmpm::return_with_tangent(sig, de, pt.mc, {slots.data(), 0, true}, d);
       EXPECT_TRUE(sig.allFinite() && d.allFinite()) << sig.transpose();
       EXPECT_GT(mean(sig), 0.0);
       EXPECT_GT(slots[0][0], 0.0);

@@ -24,6 +24,7 @@
 #include <map>
 #include <random>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "../../solver/src/materials/material.hpp"
@@ -45,7 +46,7 @@ hmpm::MaterialConstants constants(hmpm::Plasticity model) {
   m.density = 2000;
   m.youngs_modulus = young;
   m.poisson_ratio = poisson;
-  m.plasticity = model;
+  m.plasticity = std::move(model);
   return hmpm::material_constants(m, 9.81);
 }
 
