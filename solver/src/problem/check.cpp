@@ -597,7 +597,8 @@ std::vector<ProblemIssue> check_problem(const Problem& problem) {
               "': set its time.scheme to 'quasi_static' (a gravity stage in any scheme may "
               "come before it)");
     if (!std::any_of(last.materials.begin(), last.materials.end(), [](const Material& m) {
-          return !std::holds_alternative<LinearElastic>(m.plasticity);
+          return std::holds_alternative<MohrCoulomb>(m.plasticity) ||
+                 std::holds_alternative<DruckerPrager>(m.plasticity);
         }))
       add({"strength_reduction"},
           "needs a material with a strength (mohr_coulomb or drucker_prager): elastic soil "
