@@ -92,10 +92,61 @@ TEST(CamClayScheme, QuasiStaticOedometerKeepsTheVolumeLawsAndTheNcl) {
       worst_law, worst_volume, slope, lambda, k0, at(2, last, i, 1, 0), mean(last, i) / 1e3,
       static_cast<long long>(r.iterations.nonlinear), static_cast<long long>(r.steps),
       r.iterations.max_nonlinear);
+  for (std::size_t i = 0; i < np; ++i) {  // set-up: e0 and p'c = OCR p'0
+    EXPECT_EQ(at(2, 0, i, 1, 0), e0);
+    EXPECT_NEAR(at(3, 0, i, 1, 0), p0, 1e-9 * p0);
+  }
   EXPECT_LT(worst_law, 1e-9);
   EXPECT_LT(worst_volume, 1e-3);
   EXPECT_NEAR(slope, lambda, 0.02 * lambda);
   EXPECT_LE(r.iterations.max_nonlinear, 8);
+}
+
+// The explicit scheme, p'c a function of position: set-up writes each
+// particle's p'c from its initial position and e0 (the series at t = 0);
+// the column under its initial stress stays at rest, elastic.
+TEST(CamClayScheme, ExplicitColumnTakesPreconsolidationFromPosition) {
+  hmpm::Problem p = problems::column(1, 0, 1.0, 10, 2);
+  hmpm::Material m;
+  m.name = "clay";
+  m.density = 2000;
+  m.youngs_modulus = 3 * 0.5 * 2 * 4e5 / kappa;  // at the largest p'c
+  m.poisson_ratio = 0.25;
+  hmpm::ModifiedCamClay cc;
+  cc.lambda = lambda;
+  cc.kappa = kappa;
+  cc.initial_void_ratio = e0;
+  cc.preconsolidation_pressure = [](const hmpm::Vec3& x) { return 3e5 + 1e5 * x[0]; };
+  m.plasticity = cc;
+  p.materials.push_back(m);
+  for (int c = 0; c < 3; ++c)
+    p.bodies[0].initial.effective_stress[c] = [](const hmpm::Vec3&) { return -p0; };
+  p.boundaries.push_back(problems::fixed_velocity(problems::plane(p, 0, 0.0), 0));
+  hmpm::Traction t;
+  t.particles.min = {1.0 - 0.05, 0, 0};
+  t.particles.max = {1.0, 1, 1};
+  t.axis = 0;
+  t.side = +1;
+  t.traction[0] = [](double) { return -p0; };
+  p.tractions.push_back(t);
+  p.time.end = 0.01;
+  p.output.series_particles = {0, 9, 19};
+  p.output.series_fields = {hmpm::Field::effective_stress, hmpm::Field::void_ratio,
+                            hmpm::Field::preconsolidation_pressure};
+  const hmpm::RunResult r = hmpm::run(p);
+  ASSERT_EQ(r.status, hmpm::RunStatus::successful) << r.message;
+  const hmpm::Series& s = r.series;
+  const std::size_t np = s.particles.size(), last = s.time.size() - 1;
+  for (std::size_t i = 0; i < np; ++i) {
+    const double x0 = s.initial_positions[i][0];
+    EXPECT_EQ(s.values[1][i], e0);
+    EXPECT_NEAR(s.values[2][i], 3e5 + 1e5 * x0, 1e-6);
+    EXPECT_NEAR(s.values[2][last * np + i], 3e5 + 1e5 * x0, 1e-6);  // elastic: kept
+    EXPECT_NEAR(s.values[0][(last * np + i) * 6], -p0, 0.05 * p0);
+    EXPECT_NEAR(s.values[1][last * np + i], e0, 1e-3);
+  }
+  std::printf("explicit Cam-Clay column: %lld steps, p'c %.0f .. %.0f Pa at t = 0\n",
+              static_cast<long long>(r.steps), s.values[2][0], s.values[2][np - 1]);
 }
 
 }  // namespace
