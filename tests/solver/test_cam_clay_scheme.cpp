@@ -149,4 +149,68 @@ TEST(CamClayScheme, ExplicitColumnTakesPreconsolidationFromPosition) {
               static_cast<long long>(r.steps), s.values[2][0], s.values[2][np - 1]);
 }
 
+// A stage that gives a body Cam-Clay: the particles' state starts from
+// their stress at that moment (e0 and OCR x p'), after an elastic first
+// stage loaded the oedometer to 2 p'0; the load then stays, so the clay
+// (OCR 2) stays elastic and keeps that p'c.
+TEST(CamClayScheme, AStageSwitchStartsTheStateFromTheStressThen) {
+  hmpm::Problem p = problems::column(1, 0, 1.0, 10, 2);
+  hmpm::Material elastic;
+  elastic.name = "elastic";
+  elastic.density = 2000;
+  elastic.youngs_modulus = 2e7;
+  elastic.poisson_ratio = 0.25;
+  p.materials.push_back(elastic);
+  hmpm::Material clay = elastic;
+  clay.name = "clay";
+  hmpm::ModifiedCamClay cc;
+  cc.lambda = lambda;
+  cc.kappa = kappa;
+  cc.initial_void_ratio = e0;
+  cc.overconsolidation_ratio = 2.0;
+  clay.plasticity = cc;
+  p.materials.push_back(clay);
+  for (int c = 0; c < 3; ++c)
+    p.bodies[0].initial.effective_stress[c] = [](const hmpm::Vec3&) { return -p0; };
+  p.boundaries.push_back(problems::fixed_velocity(problems::plane(p, 0, 0.0), 0));
+  hmpm::Traction t;
+  t.particles.min = {1.0 - 0.05, 0, 0};
+  t.particles.max = {1.0, 1, 1};
+  t.axis = 0;
+  t.side = +1;
+  t.traction[0] = [](double time) { return -p0 * (1.0 + std::min(1.0, time)); };
+  p.tractions.push_back(t);
+  p.time.scheme = hmpm::Scheme::quasi_static;
+  p.time.end = 1.0;
+  p.time.dt = 0.25;
+  hmpm::Stage switched;
+  switched.name = "cam-clay";
+  switched.end = 2.0;
+  switched.body_materials = {{0, 1}};
+  p.stages.push_back(switched);
+  p.output.series_particles = {0, 5, 10};
+  p.output.series_fields = {hmpm::Field::effective_stress, hmpm::Field::void_ratio,
+                            hmpm::Field::preconsolidation_pressure};
+  const hmpm::RunResult r = hmpm::run(p);
+  ASSERT_EQ(r.status, hmpm::RunStatus::successful) << r.message;
+  const hmpm::Series& s = r.series;
+  const std::size_t np = s.particles.size(), last = s.time.size() - 1;
+  for (std::size_t i = 0; i < np; ++i) {
+    EXPECT_EQ(s.values[1][i], 0.0);  // elastic in the first stage: no state
+    const double* sig = &s.values[0][(last * np + i) * 6];
+    const double mean = -(sig[0] + sig[1] + sig[2]) / 3.0;
+    std::printf("after the switch: particle %lld e %.9f p'c %.1f Pa, 2 p' %.1f Pa\n",
+                static_cast<long long>(s.particles[i]), s.values[1][last * np + i],
+                s.values[2][last * np + i], 2 * mean);
+    // The second stage re-solves equilibrium with the clay's stiffness in
+    // the moved configuration (0.15 % of p'), elastically: p'c stays what
+    // the switch set, OCR times the stress then.
+    EXPECT_NEAR(s.values[1][last * np + i], e0, 1e-4);
+    EXPECT_NEAR(s.values[2][last * np + i], 2 * mean, 5e-3 * mean);
+    for (std::size_t k = 0; k <= last; ++k)
+      if (s.time[k] > 1.0 + 1e-9) EXPECT_EQ(s.values[2][k * np + i], s.values[2][last * np + i]);
+    EXPECT_GT(mean, 1.2 * p0);  // the elastic stage's load, not the initial stress
+  }
+}
+
 }  // namespace
