@@ -18,6 +18,16 @@ double Simulation<Dim, Shape>::parameter_at(std::size_t p, MaterialParameter k) 
 }
 
 template <int Dim, class Shape>
+double Simulation<Dim, Shape>::cam_clay_value(std::size_t p, Field f) const {
+  using M = constitutive::ModifiedCamClayModel;
+  if (model_.constants[particles_.material[p]].model != Model::modified_cam_clay ||
+      static_cast<int>(particles_.internal.size()) < M::state_variables)
+    return 0.0;
+  return particles_
+      .internal[f == Field::void_ratio ? M::void_ratio_slot : M::preconsolidation_slot][p];
+}
+
+template <int Dim, class Shape>
 double Simulation<Dim, Shape>::excess_pore_pressure(std::size_t p) const {
   if (particles_.pressure_out.empty() || !model_.constants[particles_.material[p]].saturated)
     return 0.0;
@@ -89,6 +99,14 @@ void Simulation<Dim, Shape>::fill_snapshot(Snapshot& snap, const std::vector<Fie
         snap.excess_pore_pressure.resize(n);
         for (std::size_t p = 0; p < n; ++p) snap.excess_pore_pressure[p] = excess_pore_pressure(p);
         break;
+      case Field::void_ratio:
+      case Field::preconsolidation_pressure: {
+        std::vector<double>& out =
+            f == Field::void_ratio ? snap.void_ratio : snap.preconsolidation_pressure;
+        out.resize(n);
+        for (std::size_t p = 0; p < n; ++p) out[p] = cam_clay_value(p, f);
+        break;
+      }
       case Field::effective_stress:
         voigt(snap.effective_stress, particles_.stress);
         break;
@@ -166,6 +184,10 @@ void Simulation<Dim, Shape>::sample_series(Series& series, double t) const {
           break;
         case Field::excess_pore_pressure:
           out.push_back(excess_pore_pressure(p));
+          break;
+        case Field::void_ratio:
+        case Field::preconsolidation_pressure:
+          out.push_back(cam_clay_value(p, series.fields[f]));
           break;
         case Field::effective_stress:
           for (int c = 0; c < 6; ++c) out.push_back(particles_.stress[p][c]);

@@ -17,6 +17,7 @@
 #include "boundary/constraints.hpp"
 #include "boundary/tractions.hpp"
 #include "geostatic.hpp"
+#include "materials/cam_clay_state.hpp"
 #include "materials/varying.hpp"
 #include "particle_layout.hpp"
 #include "simulation.hpp"
@@ -45,6 +46,9 @@ Simulation<Dim, Shape>::Simulation(const Problem& problem, const RunOptions& opt
     setup_reactions<Dim>(reactions_, model_.constraints, grid_.count,
                          model_.problem.boundaries.size());
   setup_geostatic();
+  // Cam-Clay's e0 and p'c, from the initial stresses just set.
+  initialise_cam_clay_state(particles_, model_.problem.materials, model_.constants);
+  initialise_cam_clay_state(dormant_, model_.problem.materials, model_.constants);
   interrupt_.check();
 }
 

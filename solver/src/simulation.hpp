@@ -271,6 +271,9 @@ class Simulation {
   /// Particle p's value of a material parameter: its own where it varies,
   /// else its material's.
   double parameter_at(std::size_t p, MaterialParameter k) const;
+  /// Field::void_ratio or Field::preconsolidation_pressure at particle p:
+  /// its Cam-Clay state variable, 0 at particles of other models.
+  double cam_clay_value(std::size_t p, Field f) const;
   /// Appends the excess pore pressure at time t to `c`
   /// (OutputRequest::consolidation): of every particle in the run when the
   /// request counts all, else of `counted` (job particle indices).

@@ -15,6 +15,7 @@
 
 #include "boundary/constraints.hpp"
 #include "boundary/tractions.hpp"
+#include "materials/cam_clay_state.hpp"
 #include "simulation.hpp"
 
 namespace hmpm {
@@ -47,6 +48,9 @@ void Simulation<Dim, Shape>::switch_materials(const Stage& stage) {
           if (!state->plastic_strain.empty()) state->plastic_strain[p] = 0.0;
           for (std::vector<double>& v : state->internal) v[p] = 0.0;
         }
+  // A body that becomes Cam-Clay starts from its stress now (its slots are 0).
+  for (ParticleState<Dim>* state : {&particles_, &dormant_})
+    initialise_cam_clay_state(*state, model_.problem.materials, model_.constants);
 }
 
 template <int Dim, class Shape>

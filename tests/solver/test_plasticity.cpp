@@ -14,6 +14,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <utility>
 
 #include "hmpm/run.hpp"
 #include "problems.hpp"
@@ -28,7 +29,7 @@ hmpm::Material soil(hmpm::Plasticity model, double nu) {
   m.density = 2000;
   m.youngs_modulus = 1e7;
   m.poisson_ratio = nu;
-  m.plasticity = model;
+  m.plasticity = std::move(model);
   return m;
 }
 

@@ -24,6 +24,7 @@
 #include <map>
 #include <random>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "../../solver/src/materials/material.hpp"
@@ -45,7 +46,7 @@ hmpm::MaterialConstants constants(hmpm::Plasticity model) {
   m.density = 2000;
   m.youngs_modulus = young;
   m.poisson_ratio = poisson;
-  m.plasticity = model;
+  m.plasticity = std::move(model);
   return hmpm::material_constants(m, 9.81);
 }
 
@@ -77,6 +78,7 @@ std::string region(const Voigt& trial, const hmpm::MaterialConstants& mc) {
       for (int i = 0; i < a.count; ++i) name += " " + std::to_string(a.planes[i]);
       return name;
     }
+    case hmpm::Model::modified_cam_clay:  // test_cam_clay_tangent.cpp
     case hmpm::Model::linear_elastic:
       break;
   }

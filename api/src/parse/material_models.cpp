@@ -2,6 +2,9 @@
 #include "material_models.hpp"
 
 #include <algorithm>
+#include <limits>
+
+#include "expression.hpp"
 
 namespace hmpm::api::parse {
 namespace {
@@ -32,6 +35,47 @@ const ModelParameter mohr_coulomb_parameters[] = {
     {"tensile_strength", Range::non_negative(), 0.0, false},
 };
 
+// ------------------------------------------------- Modified Cam-Clay parameters
+enum CamClayParameter : std::size_t {
+  ncl_slope,
+  url_slope,
+  critical_ratio,
+  void_ratio,
+  preconsolidation,
+  overconsolidation
+};
+
+std::string kappa_below_lambda(double kappa, std::span<const double> earlier) {
+  const double lambda = earlier[ncl_slope];
+  if (kappa >= lambda)
+    return "is " + format_number(kappa) + ", not below lambda " + format_number(lambda) +
+           ": the unloading-reloading line must be flatter than the normal compression line "
+           "(kappa/lambda is about 0.1-0.3 for clays, e.g. lambda 0.1, kappa 0.02)";
+  return {};
+}
+
+std::string critical_state_ratio_plausible(double m, std::span<const double>) {
+  if (m > 3.0)
+    return "is " + format_number(m) +
+           "; M = 6 sin(phi')/(3 - sin(phi')) is at most 3 (phi' = 90 degrees), about 0.8-1.4 "
+           "for clays (phi' 20-35 degrees)";
+  return {};
+}
+
+// preconsolidation_pressure may also be a formula in x, y, z (materials.cpp
+// reads it); fallback 0 marks it absent.
+const ModelParameter cam_clay_parameters[] = {
+    {"lambda", Range::positive(), 0.1, true},
+    {"kappa", Range::positive(), 0.03, true, kappa_below_lambda},
+    {"critical_state_ratio", Range::positive(), 1.2, true, critical_state_ratio_plausible},
+    {"initial_void_ratio", Range::positive(), 1.0, true},
+    {"preconsolidation_pressure", Range::positive(), 0.0, false},
+    {"overconsolidation_ratio",
+     {1.0, std::numeric_limits<double>::infinity(), false, false},
+     0.0,
+     false},
+};
+
 // ------------------------------------------------------------------ the table
 const MaterialModel model_table[] = {
     {"linear_elastic", {}, [](std::span<const double>) -> Plasticity { return LinearElastic{}; }},
@@ -42,6 +86,19 @@ const MaterialModel model_table[] = {
     {"drucker_prager", mohr_coulomb_parameters,
      [](std::span<const double> v) -> Plasticity {
        return DruckerPrager{v[friction], v[dilatancy], v[cohesion], v[tension]};
+     }},
+    {"modified_cam_clay", cam_clay_parameters,
+     [](std::span<const double> v) -> Plasticity {
+       ModifiedCamClay m;
+       m.lambda = v[ncl_slope];
+       m.kappa = v[url_slope];
+       m.critical_state_ratio = v[critical_ratio];
+       m.initial_void_ratio = v[void_ratio];
+       // A number; materials.cpp replaces it by the formula when it is one.
+       if (v[preconsolidation] > 0)
+         m.preconsolidation_pressure = constant_field_of_position(v[preconsolidation]);
+       m.overconsolidation_ratio = v[overconsolidation] > 0 ? v[overconsolidation] : 1.0;
+       return m;
      }},
 };
 

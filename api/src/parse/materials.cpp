@@ -12,8 +12,8 @@ namespace {
 // Keys every material reads; the model's parameters and "hydraulic" follow.
 constexpr std::string_view material_common_allowed[] = {"model", "density", "youngs_modulus",
                                                         "poisson_ratio"};
-constexpr std::string_view material_required[] = {"model", "density", "youngs_modulus",
-                                                  "poisson_ratio"};
+// youngs_modulus too, except for modified_cam_clay (read_material).
+constexpr std::string_view material_required[] = {"model", "density", "poisson_ratio"};
 constexpr std::string_view hydraulic_allowed[] = {"porosity",           "hydraulic_conductivity",
                                                   "fluid_bulk_modulus", "fluid_density",
                                                   "solid_bulk_modulus", "darcy_inertia"};
@@ -69,12 +69,23 @@ Plasticity read_model(ParseContext& c, Material& mat, const MaterialModel& model
       r.error(child_pointer(path, p.key),
               "is required for model '" + std::string(model.name) + "'");
   std::vector<double> values;
+  FieldOfPosition position_value;
   for (const ModelParameter& p : model.parameters) {
     values.push_back(p.fallback);
     if (!j.contains(p.key)) continue;
     const std::string pp = child_pointer(path, p.key);
     const json& value = j[std::string(p.key)];
     const std::optional<MaterialParameter> k = varying_parameter(p.key);
+    if (p.key == "preconsolidation_pressure" && value.is_string()) {
+      // A formula in x, y, z, evaluated at set-up at each particle of the
+      // material (values below 100 Pa or not finite are taken as 100 Pa,
+      // materials/modified_cam_clay.hpp); not in the finiteness check of
+      // a body's formulas, as the bodies of the material are not read yet.
+      const std::size_t before = c.position_formulas.size();
+      position_value = read_value_of_position(c, value, pp);
+      c.position_formulas.resize(before);
+      continue;
+    }
     if (auto v = k ? read_varying(c, mat, *k, value, pp, p.range) : r.number(value, pp, p.range)) {
       values.back() = *v;
       if (p.check)
@@ -82,7 +93,20 @@ Plasticity read_model(ParseContext& c, Material& mat, const MaterialModel& model
           r.error(pp, std::move(why));
     }
   }
-  return model.build(values);
+  Plasticity out = model.build(values);
+  if (auto* cc = std::get_if<ModifiedCamClay>(&out)) {
+    const bool pc = j.contains("preconsolidation_pressure"),
+               ocr = j.contains("overconsolidation_ratio");
+    if (pc == ocr)
+      r.error(child_pointer(path, "preconsolidation_pressure"),
+              pc ? "is given with overconsolidation_ratio; give one of them (p'c itself, or OCR "
+                   "times the initial mean effective stress)"
+                 : "or overconsolidation_ratio is required for model 'modified_cam_clay' (p'c "
+                   "itself, or OCR times the initial mean effective stress; 1 for a normally "
+                   "consolidated clay)");
+    if (position_value) cc->preconsolidation_pressure = position_value;
+  }
+  return out;
 }
 
 void read_hydraulic(ParseContext& c, Material& m, const json& j, const std::string& path) {
@@ -131,6 +155,23 @@ void read_material(ParseContext& c, const std::string& name, const json& j,
       if (auto s = r.one_of(j["model"], path + "/model", material_model_names()))
         model = find_material_model(*s);
     m.plasticity = read_model(c, m, *model, j, path);
+    if (const auto* cc = std::get_if<ModifiedCamClay>(&m.plasticity)) {
+      // Optional: the reference stiffness of the stable-step rules and the
+      // implicit schemes' scalings; by default the elastic E at p' = p'c
+      // when p'c is a number, else at 100 kPa (docs/job-spec.md).
+      if (!j.contains("youngs_modulus")) {
+        const double p_ref = j.contains("preconsolidation_pressure") &&
+                                     j["preconsolidation_pressure"].is_number() &&
+                                     j["preconsolidation_pressure"].get<double>() > 0
+                                 ? j["preconsolidation_pressure"].get<double>()
+                                 : 1e5;
+        if (cc->kappa > 0 && cc->initial_void_ratio > 0 && m.poisson_ratio < 0.5)
+          m.youngs_modulus = 3.0 * (1.0 - 2.0 * m.poisson_ratio) * (1.0 + cc->initial_void_ratio) *
+                             p_ref / cc->kappa;
+      }
+    } else if (!j.contains("youngs_modulus")) {
+      r.error(child_pointer(path, "youngs_modulus"), "is required");
+    }
     if (j.contains("hydraulic")) read_hydraulic(c, m, j["hydraulic"], path + "/hydraulic");
   }
   c.material_index[name] = static_cast<int>(c.p.materials.size());

@@ -142,6 +142,10 @@ const std::vector<double>* snapshot_array(const Snapshot& s, Field f) {
       return &s.hydraulic_conductivity;
     case Field::excess_pore_pressure:
       return &s.excess_pore_pressure;
+    case Field::void_ratio:
+      return &s.void_ratio;
+    case Field::preconsolidation_pressure:
+      return &s.preconsolidation_pressure;
   }
   return nullptr;
 }

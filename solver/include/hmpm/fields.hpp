@@ -38,6 +38,10 @@ enum class Field : std::uint8_t {
   friction_angle,
   hydraulic_conductivity,
   excess_pore_pressure,
+  // Modified Cam-Clay's state variables (0 at particles of other models);
+  // in the default snapshot fields only when some material is Cam-Clay.
+  void_ratio,
+  preconsolidation_pressure,
 };
 
 /// scalar: 1 component; vector: one per axis (dim); tensor: 6 in Voigt
@@ -52,7 +56,7 @@ struct FieldInfo {
 };
 
 /// Every field, in the order of the Field enumerators.
-inline constexpr std::array<FieldInfo, 15> field_table{{
+inline constexpr std::array<FieldInfo, 17> field_table{{
     {Field::position, "position", FieldKind::vector, "m"},
     {Field::displacement, "displacement", FieldKind::vector, "m"},
     {Field::velocity, "velocity", FieldKind::vector, "m/s"},
@@ -77,6 +81,10 @@ inline constexpr std::array<FieldInfo, 15> field_table{{
     // else the hydrostatic pressure under the geostatic water table, else
     // 0); zero where the material has no pore water.
     {Field::excess_pore_pressure, "excess_pore_pressure", FieldKind::scalar, "Pa"},
+    // Modified Cam-Clay's void ratio e and preconsolidation pressure p'c
+    // (compression positive); 0 at particles of other models.
+    {Field::void_ratio, "void_ratio", FieldKind::scalar, "-"},
+    {Field::preconsolidation_pressure, "preconsolidation_pressure", FieldKind::scalar, "Pa"},
 }};
 inline constexpr int field_count = static_cast<int>(field_table.size());
 
@@ -90,6 +98,11 @@ static_assert(field_table_is_in_enum_order(), "field_table rows must follow the 
 /// The fields of the material parameters: youngs_modulus and after.
 constexpr bool is_material_parameter_field(Field f) {
   return f >= Field::youngs_modulus && f <= Field::hydraulic_conductivity;
+}
+
+/// The fields of Modified Cam-Clay's state variables.
+constexpr bool is_cam_clay_field(Field f) {
+  return f == Field::void_ratio || f == Field::preconsolidation_pressure;
 }
 
 /// What field_info gives for a value outside the enumerators: "?", one component.

@@ -90,7 +90,27 @@ struct DruckerPrager {
   double tensile_strength = 0.0;
 };
 
-using Plasticity = std::variant<LinearElastic, MohrCoulomb, DruckerPrager>;
+/// Modified Cam-Clay (Roscoe & Burland): yield surface
+/// q^2/M^2 + p'(p' - p'c) = 0 (p' compression positive), associated flow,
+/// isotropic hardening of p'c with the plastic volumetric strain, elastic
+/// bulk modulus K = (1 + e) p' / kappa with a constant Poisson's ratio
+/// (Material::poisson_ratio). The void ratio e and p'c are per-particle
+/// state variables (materials/modified_cam_clay.hpp). Material::youngs_modulus
+/// is then only a reference stiffness for the stable-step rules, the
+/// quasi-static scheme's scalings and the plausibility checks (the api sets
+/// it to the elastic Young's modulus at p' = p'c, docs/job-spec.md).
+struct ModifiedCamClay {
+  double lambda = 0.1;                ///< slope of the NCL in e - ln p'
+  double kappa = 0.03;                ///< slope of the unloading-reloading line
+  double critical_state_ratio = 1.2;  ///< M
+  double initial_void_ratio = 1.0;    ///< e at the initial stress
+  /// p'c in Pa at each particle's initial position; empty: the
+  /// overconsolidation ratio times the particle's initial mean effective stress.
+  FieldOfPosition preconsolidation_pressure;
+  double overconsolidation_ratio = 1.0;  ///< used when preconsolidation_pressure is empty
+};
+
+using Plasticity = std::variant<LinearElastic, MohrCoulomb, DruckerPrager, ModifiedCamClay>;
 
 /// A material parameter that may vary from particle to particle (each has
 /// its output field of the same name, fields.hpp). Cam-Clay's

@@ -169,18 +169,20 @@ struct Snapshot {
   bool mechanism = false;
   int dimension = 1;
   std::int64_t particles = 0;
-  std::vector<Field> fields;                 ///< which of the arrays below are filled
-  std::vector<double> position;              ///< 3 per particle
-  std::vector<double> displacement;          ///< 3
-  std::vector<double> velocity;              ///< 3
-  std::vector<double> pore_pressure;         ///< 1
-  std::vector<double> darcy_velocity;        ///< 3
-  std::vector<double> effective_stress;      ///< 6
-  std::vector<double> total_stress;          ///< 6
-  std::vector<double> strain;                ///< 6
-  std::vector<double> porosity;              ///< 1
-  std::vector<double> plastic_strain;        ///< 1, accumulated equivalent plastic strain
-  std::vector<double> excess_pore_pressure;  ///< 1, pore pressure minus the steady one
+  std::vector<Field> fields;                      ///< which of the arrays below are filled
+  std::vector<double> position;                   ///< 3 per particle
+  std::vector<double> displacement;               ///< 3
+  std::vector<double> velocity;                   ///< 3
+  std::vector<double> pore_pressure;              ///< 1
+  std::vector<double> darcy_velocity;             ///< 3
+  std::vector<double> effective_stress;           ///< 6
+  std::vector<double> total_stress;               ///< 6
+  std::vector<double> strain;                     ///< 6
+  std::vector<double> porosity;                   ///< 1
+  std::vector<double> plastic_strain;             ///< 1, accumulated equivalent plastic strain
+  std::vector<double> excess_pore_pressure;       ///< 1, pore pressure minus the steady one
+  std::vector<double> void_ratio;                 ///< 1, Cam-Clay's e (0 elsewhere)
+  std::vector<double> preconsolidation_pressure;  ///< 1, Cam-Clay's p'c, Pa (0 elsewhere)
   /// 1 each: the material parameters at the particles (Field::youngs_modulus ...).
   std::vector<double> youngs_modulus, cohesion, friction_angle, hydraulic_conductivity;
   std::vector<double> volume;  ///< 1, always filled

@@ -12,8 +12,9 @@
 // (`state_variables`); the particle state holds them as a structure of
 // arrays (ParticleState::internal, one array per variable, sized for the
 // largest count among the materials that have particles) and the stress
-// update hands the model its particle's slots (InternalState). The three
-// models of today are perfectly plastic and declare none.
+// update hands the model its particle's slots (InternalState). Linear
+// elasticity, Mohr-Coulomb and Drucker-Prager declare none; Modified
+// Cam-Clay keeps two (the void ratio and p'c, modified_cam_clay.hpp).
 #pragma once
 
 #include <cmath>
@@ -27,6 +28,7 @@
 #include "elastic.hpp"
 #include "hmpm/problem.hpp"
 #include "linear_elastic.hpp"
+#include "modified_cam_clay.hpp"
 #include "mohr_coulomb.hpp"
 #include "varying.hpp"
 
@@ -34,7 +36,15 @@ namespace hmpm {
 
 /// Which stress update a material uses after the elastic trial: one entry
 /// per file of materials/ (the order is not significant).
-enum class Model : std::uint8_t { linear_elastic, mohr_coulomb, drucker_prager };
+enum class Model : std::uint8_t { linear_elastic, mohr_coulomb, drucker_prager, modified_cam_clay };
+
+/// Whether the caller computes the elastic trial sigma_n + D_e deps with
+/// the material's constant elasticity before the return (every model but
+/// Modified Cam-Clay, whose pressure-dependent elasticity makes the trial
+/// its own: it takes sigma_n and deps, modified_cam_clay.hpp).
+constexpr bool elastic_trial_outside(Model m) {
+  return m != Model::modified_cam_clay;
+}
 
 /// Number of per-particle internal state variables the model keeps.
 constexpr int state_variable_count(Model m) {
@@ -43,6 +53,8 @@ constexpr int state_variable_count(Model m) {
       return constitutive::MohrCoulombModel::state_variables;
     case Model::drucker_prager:
       return constitutive::DruckerPragerModel::state_variables;
+    case Model::modified_cam_clay:
+      return constitutive::ModifiedCamClayModel::state_variables;
     case Model::linear_elastic:
       break;
   }
@@ -50,10 +62,13 @@ constexpr int state_variable_count(Model m) {
 }
 
 /// One particle's internal state variables: variable k is arrays[k][p].
-/// Models that declare none never touch it.
+/// Models that declare none never touch it. `commit` false: the update
+/// reads the state at the step's start and leaves it (the Newton
+/// iterations of the quasi-static scheme); true: it writes the new state.
 struct InternalState {
   std::vector<double>* arrays;
   std::size_t p;
+  bool commit = true;
   double& operator[](int k) const { return arrays[k][p]; }
 };
 
@@ -62,6 +77,7 @@ struct MaterialConstants {
   constitutive::Elastic elastic{0.0, 0.0};              ///< the trial's lambda and G
   constitutive::MohrCoulombConstants mohr_coulomb;      ///< used when model == mohr_coulomb
   constitutive::DruckerPragerConstants drucker_prager;  ///< used when model == drucker_prager
+  constitutive::ModifiedCamClayConstants cam_clay;      ///< used when model == modified_cam_clay
   double lambda = 0.0;                                  ///< Lame's first parameter, Pa
   double shear_modulus = 0.0;                           ///< G, Pa
   double constrained_modulus = 0.0;                     ///< E(1-nu)/((1+nu)(1-2nu)), Pa
@@ -85,7 +101,7 @@ inline MaterialConstants material_constants(const Material& m, double gravity_co
   c.undrained_p_modulus = c.constrained_modulus;
   c.elastic = {c.lambda, c.shear_modulus};
   std::visit(
-      [&c](const auto& model) {
+      [&c, nu](const auto& model) {
         using T = std::decay_t<decltype(model)>;
         if constexpr (std::is_same_v<T, MohrCoulomb>) {
           c.model = Model::mohr_coulomb;
@@ -93,6 +109,9 @@ inline MaterialConstants material_constants(const Material& m, double gravity_co
         } else if constexpr (std::is_same_v<T, DruckerPrager>) {
           c.model = Model::drucker_prager;
           c.drucker_prager = constitutive::make_drucker_prager(model);
+        } else if constexpr (std::is_same_v<T, ModifiedCamClay>) {
+          c.model = Model::modified_cam_clay;
+          c.cam_clay = constitutive::make_modified_cam_clay(model, nu);
         }
       },
       m.plasticity);
@@ -112,6 +131,22 @@ inline MaterialConstants material_constants(const Material& m, double gravity_co
   return c;
 }
 
+/// Modified Cam-Clay's update of particle state `state` (material.hpp's
+/// slots 0 e, 1 p'c): sig holds sigma_n on entry; the new state is written
+/// when state.commit.
+inline double update_cam_clay(constitutive::Voigt& sig, const constitutive::Voigt& de,
+                              const MaterialConstants& mc, InternalState state,
+                              constitutive::Tangent* d_alg) {
+  using M = constitutive::ModifiedCamClayModel;
+  double e = state[M::void_ratio_slot], pc = state[M::preconsolidation_slot];
+  const double plastic = constitutive::update_modified_cam_clay(sig, de, mc.cam_clay, e, pc, d_alg);
+  if (state.commit) {
+    state[M::void_ratio_slot] = e;
+    state[M::preconsolidation_slot] = pc;
+  }
+  return plastic;
+}
+
 /// Plastic correction of the elastic trial stress (effective stress, so dry
 /// and saturated alike): the closed-form return mapping of the material's
 /// model; linear-elastic materials in a run with plastic ones pass through.
@@ -120,9 +155,13 @@ inline MaterialConstants material_constants(const Material& m, double gravity_co
 /// the plastic strain increment, tensor components), 0 when elastic.
 /// For particle p, whose parameters may vary (materials/varying.hpp): `el`
 /// is the elasticity of its trial, and its strength constants are its own
-/// where `varying` has them.
-inline double return_to_yield_surface(constitutive::Voigt& sig, const MaterialConstants& mc,
-                                      const constitutive::Elastic& el,
+/// where `varying` has them. `de` is the step's strain increment (tensor
+/// components): for a model whose trial is its own
+/// (!elastic_trial_outside(mc.model): Modified Cam-Clay) `sig` holds sigma_n
+/// on entry, not the trial, and the update takes de; the others ignore it.
+inline double return_to_yield_surface(constitutive::Voigt& sig,
+                                      [[maybe_unused]] const constitutive::Voigt& de,
+                                      const MaterialConstants& mc, const constitutive::Elastic& el,
                                       const VaryingConstants& varying, std::size_t p,
                                       [[maybe_unused]] InternalState state) {
   switch (mc.model) {
@@ -132,6 +171,8 @@ inline double return_to_yield_surface(constitutive::Voigt& sig, const MaterialCo
     case Model::drucker_prager:
       return constitutive::return_drucker_prager(
           sig, el, varying.drucker_prager.empty() ? mc.drucker_prager : varying.drucker_prager[p]);
+    case Model::modified_cam_clay:
+      return update_cam_clay(sig, de, mc, state, nullptr);
     case Model::linear_elastic:
       break;
   }
@@ -152,10 +193,16 @@ inline double permeability_of(const MaterialConstants& mc, const VaryingConstant
 }
 
 /// The same for a material's own constants (a homogeneous material).
+inline double return_to_yield_surface(constitutive::Voigt& sig, const constitutive::Voigt& de,
+                                      const MaterialConstants& mc, InternalState state) {
+  static const VaryingConstants homogeneous;
+  return return_to_yield_surface(sig, de, mc, mc.elastic, homogeneous, 0, state);
+}
+
+/// The same for a model whose trial is outside (sig: the trial; no de).
 inline double return_to_yield_surface(constitutive::Voigt& sig, const MaterialConstants& mc,
                                       InternalState state) {
-  static const VaryingConstants homogeneous;
-  return return_to_yield_surface(sig, mc, mc.elastic, homogeneous, 0, state);
+  return return_to_yield_surface(sig, constitutive::Voigt::Zero(), mc, state);
 }
 
 /// The increment of the accumulated equivalent plastic strain,
@@ -177,7 +224,9 @@ inline constitutive::Tangent elastic_tangent(const MaterialConstants& mc) {
 /// sigma_n + D_e (eps_{n+1} - eps_n) on entry and the returned stress on exit
 /// (bit for bit return_to_yield_surface's); `d_alg` receives
 /// d sigma_{n+1} / d eps_{n+1} in the convention of elastic_tangent (the
-/// elastic tangent for linear-elastic materials and elastic steps).
+/// elastic tangent for linear-elastic materials and elastic steps; for
+/// Modified Cam-Clay, whose sig is sigma_n on entry and takes de as in
+/// return_to_yield_surface, its pressure-dependent elastic tangent).
 /// Returns ||d eps_p||, 0 when the step was elastic. Not for hot loops of
 /// the explicit scheme: it costs a spectral derivative per plastic point.
 inline double return_with_tangent(constitutive::Voigt& sig, const MaterialConstants& mc,
@@ -185,9 +234,11 @@ inline double return_with_tangent(constitutive::Voigt& sig, const MaterialConsta
 
 /// return_with_tangent for particle p, whose parameters may vary (as
 /// return_to_yield_surface above).
-inline double return_with_tangent(constitutive::Voigt& sig, const MaterialConstants& mc,
-                                  const constitutive::Elastic& el, const VaryingConstants& varying,
-                                  std::size_t p, [[maybe_unused]] InternalState state,
+inline double return_with_tangent(constitutive::Voigt& sig,
+                                  [[maybe_unused]] const constitutive::Voigt& de,
+                                  const MaterialConstants& mc, const constitutive::Elastic& el,
+                                  const VaryingConstants& varying, std::size_t p,
+                                  [[maybe_unused]] InternalState state,
                                   constitutive::Tangent& d_alg) {
   switch (mc.model) {
     case Model::mohr_coulomb:
@@ -197,6 +248,8 @@ inline double return_with_tangent(constitutive::Voigt& sig, const MaterialConsta
       return constitutive::return_drucker_prager_with_tangent(
           sig, el, varying.drucker_prager.empty() ? mc.drucker_prager : varying.drucker_prager[p],
           d_alg);
+    case Model::modified_cam_clay:
+      return update_cam_clay(sig, de, mc, state, &d_alg);
     case Model::linear_elastic:
       break;
   }
@@ -204,10 +257,16 @@ inline double return_with_tangent(constitutive::Voigt& sig, const MaterialConsta
   return 0.0;
 }
 
+inline double return_with_tangent(constitutive::Voigt& sig, const constitutive::Voigt& de,
+                                  const MaterialConstants& mc, InternalState state,
+                                  constitutive::Tangent& d_alg) {
+  static const VaryingConstants homogeneous;
+  return return_with_tangent(sig, de, mc, mc.elastic, homogeneous, 0, state, d_alg);
+}
+
 inline double return_with_tangent(constitutive::Voigt& sig, const MaterialConstants& mc,
                                   InternalState state, constitutive::Tangent& d_alg) {
-  static const VaryingConstants homogeneous;
-  return return_with_tangent(sig, mc, mc.elastic, homogeneous, 0, state, d_alg);
+  return return_with_tangent(sig, constitutive::Voigt::Zero(), mc, state, d_alg);
 }
 
 /// The u-p equations with Darcy's rho_f a term are not dissipative: one

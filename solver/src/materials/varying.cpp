@@ -86,7 +86,8 @@ bool parameter_applies(const Material& m, MaterialParameter k) {
       return m.hydraulic.has_value();
     case MaterialParameter::cohesion:
     case MaterialParameter::friction_angle:
-      return !std::holds_alternative<LinearElastic>(m.plasticity);
+      return std::holds_alternative<MohrCoulomb>(m.plasticity) ||
+             std::holds_alternative<DruckerPrager>(m.plasticity);
   }
   return false;
 }
@@ -133,7 +134,10 @@ std::vector<std::vector<double>> varying_values(const Problem& problem, std::siz
 std::vector<Field> default_snapshot_fields(const Problem& problem) {
   std::vector<Field> out;
   for (const FieldInfo& f : field_table) {
-    bool wanted = !is_material_parameter_field(f.field);
+    bool wanted = !is_material_parameter_field(f.field) && !is_cam_clay_field(f.field);
+    for (const Material& m : problem.materials)
+      wanted = wanted || (is_cam_clay_field(f.field) &&
+                          std::holds_alternative<ModifiedCamClay>(m.plasticity));
     for (const Material& m : problem.materials)
       for (const VaryingParameter& v : m.varying)
         wanted = wanted || v.parameter == parameter_of_field(f.field);

@@ -139,11 +139,14 @@ inline void update_particle_stress_and_fluid_flux(StepContext<Dim, Shape>& ctx,
     // Below 3D the shear increments yz and zx (in 1D also xy) are zero:
     // the loops end before them (components 0..changed_end-1 can change).
     constexpr int changed_end = Dim == 1 ? 3 : (Dim == 2 ? 4 : 6);
-    for (int c = 0; c < 3; ++c) sig[c] += lambda_tr + two_g * de[c];
-    for (int c = 3; c < changed_end; ++c) sig[c] += two_g * de[c];
+    // The elastic trial, unless the model makes its own (Cam-Clay).
+    if (!Plastic || elastic_trial_outside(mc.model)) {
+      for (int c = 0; c < 3; ++c) sig[c] += lambda_tr + two_g * de[c];
+      for (int c = 3; c < changed_end; ++c) sig[c] += two_g * de[c];
+    }
     if constexpr (Plastic) {
       const double plastic =
-          return_to_yield_surface(sig, mc, el, varying, p, {ctx.particles.internal.data(), p});
+          return_to_yield_surface(sig, de, mc, el, varying, p, {ctx.particles.internal.data(), p});
       if (plastic > 0.0) ctx.particles.plastic_strain[p] += equivalent_plastic_strain(plastic);
     }
     for (int c = 0; c < changed_end; ++c) ctx.particles.strain[p][c] += de[c];

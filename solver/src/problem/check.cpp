@@ -471,6 +471,16 @@ std::vector<ProblemIssue> check_problem(const Problem& problem) {
     if (!(m.youngs_modulus > 0)) add(w / "youngs_modulus", "must be > 0");
     if (!(m.poisson_ratio > -1.0 && m.poisson_ratio < 0.5))
       add(w / "poisson_ratio", "must be in (-1, 0.5)");
+    if (const auto* cc = std::get_if<ModifiedCamClay>(&m.plasticity)) {
+      if (!(cc->kappa > 0)) add(w / "kappa", "must be > 0");
+      if (!(cc->lambda > cc->kappa))
+        add(w / "lambda",
+            "must be greater than kappa (the NCL is steeper than the unloading line)");
+      if (!(cc->critical_state_ratio > 0)) add(w / "critical_state_ratio", "must be > 0");
+      if (!(cc->initial_void_ratio > 0)) add(w / "initial_void_ratio", "must be > 0");
+      if (!cc->preconsolidation_pressure && !(cc->overconsolidation_ratio >= 1))
+        add(w / "overconsolidation_ratio", "must be >= 1");
+    }
     if (m.hydraulic) {
       const Hydraulic& hy = *m.hydraulic;
       if (!(hy.porosity > 0 && hy.porosity < 1))
@@ -587,7 +597,8 @@ std::vector<ProblemIssue> check_problem(const Problem& problem) {
               "': set its time.scheme to 'quasi_static' (a gravity stage in any scheme may "
               "come before it)");
     if (!std::any_of(last.materials.begin(), last.materials.end(), [](const Material& m) {
-          return !std::holds_alternative<LinearElastic>(m.plasticity);
+          return std::holds_alternative<MohrCoulomb>(m.plasticity) ||
+                 std::holds_alternative<DruckerPrager>(m.plasticity);
         }))
       add({"strength_reduction"},
           "needs a material with a strength (mohr_coulomb or drucker_prager): elastic soil "

@@ -516,8 +516,12 @@ class QuasiStaticScheme final : public TimeScheme {
   /// the return too (d sigma / d eps, tensor shear strains); the return
   /// value then says whether the point was plastic (d_alg is only written
   /// when it was; elastic points take the elastic stiffness).
+  /// Models with state (Cam-Clay) read their state at the step's start and
+  /// write the new one only when `commit` (the converged step). Cam-Clay,
+  /// whose elasticity depends on the stress, always reports its tangent.
   bool particle_stress(std::size_t p, const StencilT& s, Mat& g, Voigt& de, Voigt& sig,
-                       constitutive::Tangent* d_alg = nullptr, double* plastic = nullptr) const {
+                       constitutive::Tangent* d_alg = nullptr, double* plastic = nullptr,
+                       bool commit = false) const {
     g.setZero();
     for (int k = 0; k < N; ++k) {
       const auto i = static_cast<std::size_t>(s.node[k]);
@@ -538,14 +542,16 @@ class QuasiStaticScheme final : public TimeScheme {
     const double tr = de[0] + de[1] + de[2];
     const VaryingConstants& varying = c_.particles.varying;
     const constitutive::Elastic& el = elastic_of(mc, varying, p);
-    for (int c = 0; c < 3; ++c) sig[c] += el.lambda * tr + 2.0 * el.shear * de[c];
-    for (int c = 3; c < 6; ++c) sig[c] += 2.0 * el.shear * de[c];
+    if (elastic_trial_outside(mc.model)) {
+      for (int c = 0; c < 3; ++c) sig[c] += el.lambda * tr + 2.0 * el.shear * de[c];
+      for (int c = 3; c < 6; ++c) sig[c] += 2.0 * el.shear * de[c];
+    }
     if (!c_.model.plastic) return false;
+    const InternalState state{c_.particles.internal.data(), p, commit};
     if (d_alg && mc.model != Model::linear_elastic)
-      return return_with_tangent(sig, mc, el, varying, p, {c_.particles.internal.data(), p},
-                                 *d_alg) > 0.0;
-    const double norm =
-        return_to_yield_surface(sig, mc, el, varying, p, {c_.particles.internal.data(), p});
+      return return_with_tangent(sig, de, mc, el, varying, p, state, *d_alg) > 0.0 ||
+             !elastic_trial_outside(mc.model);
+    const double norm = return_to_yield_surface(sig, de, mc, el, varying, p, state);
     if (plastic) *plastic = norm;
     return false;
   }
@@ -881,7 +887,7 @@ class QuasiStaticScheme final : public TimeScheme {
       Mat g;
       Voigt de, sig;
       double plastic = 0.0;
-      particle_stress(p, s, g, de, sig, nullptr, &plastic);
+      particle_stress(p, s, g, de, sig, nullptr, &plastic, /*commit=*/true);
       parts.stress[p] = sig;
       if (plastic > 0.0) parts.plastic_strain[p] += equivalent_plastic_strain(plastic);
       yielded_[p] = plastic > 0.0 ? 1 : 0;
