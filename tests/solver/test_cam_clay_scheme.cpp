@@ -208,7 +208,9 @@ TEST(CamClayScheme, AStageSwitchStartsTheStateFromTheStressThen) {
     EXPECT_NEAR(s.values[1][last * np + i], e0, 1e-4);
     EXPECT_NEAR(s.values[2][last * np + i], 2 * mean, 5e-3 * mean);
     for (std::size_t k = 0; k <= last; ++k)
-      if (s.time[k] > 1.0 + 1e-9) EXPECT_EQ(s.values[2][k * np + i], s.values[2][last * np + i]);
+      if (s.time[k] > 1.0 + 1e-9) {
+        EXPECT_EQ(s.values[2][k * np + i], s.values[2][last * np + i]);
+      }
     EXPECT_GT(mean, 1.2 * p0);  // the elastic stage's load, not the initial stress
   }
 }

@@ -112,7 +112,8 @@ TEST_P(DynamicCollapse, CohesionlessColumnIsReportedAfterFreeFallAndBeforeItSpre
   // The status message and the warnings say so.
   EXPECT_NE(r.message.find("collapsed"), std::string::npos) << r.message;
   bool warned = false;
-  for (const std::string& w : r.warnings) warned = warned || w.find("collapses") != std::string::npos;
+  for (const std::string& w : r.warnings)
+    warned = warned || w.find("collapses") != std::string::npos;
   EXPECT_TRUE(warned) << name(c);
   EXPECT_NEAR(r.end_time, p.time.end, 1e-9);  // it went on to the end
 }
