@@ -5,7 +5,8 @@
 // loads of the job's end held: the strength of every Mohr-Coulomb and
 // Drucker-Prager material is divided by F,
 //   c_F = c / F,   tan(phi_F) = tan(phi) / F,   psi_F = min(psi, phi_F),
-// the tensile strength by F as well, and the quasi-static scheme looks for
+// the tensile strength by F as well (a particle's own c and phi where they
+// are random fields), and the quasi-static scheme looks for
 // equilibrium from the converged state at the previous F
 // (QuasiStaticScheme::strength_reduce: Newton with the consistent tangent,
 // prescribed displacements held, pore pressures held). F starts at 1 and
@@ -68,6 +69,36 @@ void Simulation<Dim, Shape>::reduce_strength(RunResult& result, double t,
   std::fill(particles_.plastic_strain.begin(), particles_.plastic_strain.end(), 0.0);
   QuasiStaticScheme<Dim, Shape> scheme(context());
   std::vector<MaterialConstants> reduced;
+  // Where c or phi varies (a random field), every particle's return reads
+  // its own strength constants (particles_.varying, also the particles of
+  // homogeneous materials then): those are reduced with the materials' and
+  // put back when the reduction ends.
+  VaryingConstants& varying = particles_.varying;
+  const std::vector<constitutive::MohrCoulombConstants> own_mohr_coulomb = varying.mohr_coulomb;
+  const std::vector<constitutive::DruckerPragerConstants> own_drucker_prager =
+      varying.drucker_prager;
+  struct Restore {
+    VaryingConstants& v;
+    const std::vector<constitutive::MohrCoulombConstants>& mc;
+    const std::vector<constitutive::DruckerPragerConstants>& dp;
+    ~Restore() {
+      v.mohr_coulomb = mc;
+      v.drucker_prager = dp;
+    }
+  } restore{varying, own_mohr_coulomb, own_drucker_prager};
+  auto reduce_own_strength = [&](double factor) {
+    if (varying.mohr_coulomb.empty() && varying.drucker_prager.empty()) return;
+    const std::vector<Material>& materials = model_.problem.materials;
+    for (std::size_t p = 0; p < particles_.size(); ++p) {
+      Material m = materials[particles_.material[p]];
+      for (const VaryingParameter& v : m.varying)
+        set_parameter(m, v.parameter, varying.value[static_cast<std::size_t>(v.parameter)][p]);
+      const MaterialConstants c =
+          material_constants(reduced_strength(m, factor), model_.problem.gravity_constant);
+      if (!varying.mohr_coulomb.empty()) varying.mohr_coulomb[p] = c.mohr_coulomb;
+      if (!varying.drucker_prager.empty()) varying.drucker_prager[p] = c.drucker_prager;
+    }
+  };
   double f = 1.0, step = sr.increment;
   out.factors.push_back(f);
   out.max_displacement.push_back(0.0);
@@ -82,6 +113,7 @@ void Simulation<Dim, Shape>::reduce_strength(RunResult& result, double t,
     for (const Material& m : model_.problem.materials)
       reduced.push_back(
           material_constants(reduced_strength(m, next), model_.problem.gravity_constant));
+    reduce_own_strength(next);
     ++out.attempts;
     if (scheme.strength_reduce(reduced, t)) {
       f = next;
