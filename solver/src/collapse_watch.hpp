@@ -4,9 +4,10 @@
 // These schemes have no equilibrium to lose: past a limit load the soil
 // accelerates and runs out, and the run follows it. What shows a collapse
 // there is displacement on the scale of the ground itself: criterion
-// `large_displacement`, a particle that has yielded since the stage began
-// and has moved more than `collapse_fraction` (10 %) of the soil's height
-// in the stage. Elastic ground under its own weight moves rho g H^2 / (2 E)
+// `large_displacement`, a particle that has yielded and has moved more than
+// `collapse_fraction` (10 %) of the soil's height from its initial position
+// (x0: the job's start, or the last stage that reset the displacements).
+// Elastic ground under its own weight moves rho g H^2 / (2 E)
 // (0.1 % of H for a stiff soil, 1 % for a very soft one), consolidation
 // settles a few per cent slowly and mostly without yielding: neither gets
 // near 10 % of the height while yielding. A mechanism (a slope sliding, a
@@ -14,9 +15,13 @@
 // sqrt(2 * 0.1 H / g) of free fall at the fastest, and the test
 // (tests/solver/test_dynamic_collapse.cpp) checks both sides.
 //
-// The soil's height: the extent of the particles in the run along gravity
-// at the stage's start; without gravity, the smallest non-zero extent of
-// their bounding box. The time loop calls check() every few steps (about
+// The soil's height: the extent of the particles' initial positions (x0)
+// along gravity; without gravity, the smallest non-zero extent of their
+// bounding box. Both come from the checkpointed state (x, x0, plastic
+// strain), so a run resumed from a checkpoint finds a collapse it had not
+// found before at the same check as the uninterrupted run (a collapse found
+// before the checkpoint is not in it: the resumed run finds it again at its
+// first check). The time loop calls check() every few steps (about
 // 500 times per stage, with the run watch): one pass over the particles,
 // no allocation after construction, no string until found.
 #pragma once
@@ -34,7 +39,7 @@
 
 namespace hmpm {
 
-/// A yielding particle's displacement in the stage, as a fraction of the
+/// A yielding particle's displacement from x0, as a fraction of the
 /// soil's height, beyond which a dynamic run reports a collapse.
 inline constexpr double collapse_fraction = 0.1;
 
@@ -50,10 +55,9 @@ class CollapseWatch {
       : active_(stage.time.scheme != Scheme::quasi_static && !ps.plastic_strain.empty() &&
                 ps.size() > 0) {
     if (!active_) return;
-    start_ = ps.x;
     plastic_ = ps.plastic_strain;
-    Vec lo = ps.x[0], hi = ps.x[0];
-    for (const Vec& x : ps.x) {
+    Vec lo = ps.x0[0], hi = ps.x0[0];
+    for (const Vec& x : ps.x0) {
       lo = lo.cwiseMin(x);
       hi = hi.cwiseMax(x);
     }
@@ -62,7 +66,7 @@ class CollapseWatch {
     if (g.norm() > 0.0) {
       const Vec down = g / g.norm();
       double top = std::numeric_limits<double>::infinity(), bottom = -top;
-      for (const Vec& x : ps.x) {
+      for (const Vec& x : ps.x0) {
         top = std::min(top, x.dot(down));
         bottom = std::max(bottom, x.dot(down));
       }
@@ -89,7 +93,7 @@ class CollapseWatch {
     std::int64_t yielding = 0;
     Vec lo = Vec::Zero(), hi = Vec::Zero();
     for (std::size_t p = 0; p < ps.size(); ++p) {
-      const double d = (ps.x[p] - start_[p]).norm();
+      const double d = (ps.x[p] - ps.x0[p]).norm();
       moved = std::max(moved, d);
       // Yielding in the last check window: the mechanism as it is now.
       if (ps.plastic_strain[p] > plastic_[p]) {
@@ -125,7 +129,6 @@ class CollapseWatch {
   bool found_ = false;
   double height_ = 0.0;
   double worst_ = 0.0;
-  std::vector<Vec> start_;       ///< positions at the stage's start
   std::vector<double> plastic_;  ///< plastic strain at the last check
 };
 

@@ -549,9 +549,9 @@ bool Simulation<Dim, Shape>::report_dynamic_collapse(CollapseWatch<Dim>& w, doub
   };
   std::ostringstream what;
   what << "the soil collapses: at t = " << number(t) << " s a particle that yielded has moved "
-       << number(w.worst()) << " m in the stage, more than "
-       << static_cast<int>(collapse_fraction * 100) << " % of the soil's height ("
-       << number(w.height()) << " m): a mechanism; surface loads " << text(k.load) << " N";
+       << number(w.worst()) << " m, more than " << static_cast<int>(collapse_fraction * 100)
+       << " % of the soil's height (" << number(w.height()) << " m): a mechanism; surface loads "
+       << text(k.load) << " N";
   if (Dim < 3) what << (Dim == 2 ? "/m" : "/m^2");
   what << ", largest displacement " << number(k.max_displacement) << " m, " << k.yielding
        << " particles yielding";
