@@ -294,6 +294,40 @@ TEST_F(EnsembleRoutesTest, TheSameSeedGivesTheSameSamples) {
   get_json("/ensembles/00000000-0000-4000-8000-000000000000", 404);
 }
 
+// A sweep over a random field's seed (values at the pointer into the
+// field): one field per seed, so two samples of the same seed run the
+// same job to the same series, and another seed another one.
+TEST_F(EnsembleRoutesTest, ASweepOfARandomFieldsSeedGivesOneFieldPerSeed) {
+  start();
+  Json spec = json_of(small_spec("field-bar", 0.2));
+  spec["materials"]["bar"]["youngs_modulus"] = {
+      {"random_field",
+       {{"distribution", {{"lognormal", {{"mean", 1e5}, {"cov", 0.3}}}}},
+        {"correlation_length", {0.2}},
+        {"seed", 0}}}};
+  const std::string at = "/materials/bar/youngs_modulus/random_field/seed";
+  const Json created = submit({{"spec", spec},
+                               {"seed", 1},
+                               {"vary", Json::array({{{"path", at}, {"values", {5, 6, 5}}}})}});
+  ASSERT_EQ(created["jobs"].size(), 3u);
+  const Json ended = wait_ended(created["ensembleID"]);
+  EXPECT_EQ(ended["status"], "successful") << ended.dump();
+  std::vector<std::string> series;
+  for (std::size_t k = 0; k < 3; ++k) {
+    const std::string job = created["jobs"][k];
+    const Json job_spec = get_json("/jobs/" + job + "/spec");
+    const Json& seed = job_spec[Json::json_pointer(at)];
+    EXPECT_TRUE(seed.is_number_integer()) << seed.dump();
+    EXPECT_EQ(seed, (Json{5, 6, 5}[k])) << "sample " << k;
+    auto res = client_->Get(("/jobs/" + job + "/results/series.json").c_str());
+    ASSERT_TRUE(res);
+    ASSERT_EQ(res->status, 200) << res->body;
+    series.push_back(res->body);
+  }
+  EXPECT_EQ(series[0], series[2]) << "the same seed, the same field and run";
+  EXPECT_NE(series[0], series[1]) << "another seed, another field";
+}
+
 TEST_F(EnsembleRoutesTest, CancelDismissesTheUnfinishedSamplesAndDeleteRemovesThemAll) {
   start();
   Json body = request(3, 7);

@@ -2,6 +2,7 @@
 // constants, their constitutive model (parameters from material_models.cpp)
 // and their optional hydraulic properties.
 #include <algorithm>
+#include <cmath>
 
 #include "material_models.hpp"
 #include "parser.hpp"
@@ -48,6 +49,7 @@ std::optional<double> read_varying(ParseContext& c, Material& m, MaterialParamet
 std::optional<MaterialParameter> varying_parameter(std::string_view key) {
   if (key == "cohesion") return MaterialParameter::cohesion;
   if (key == "friction_angle") return MaterialParameter::friction_angle;
+  if (key == "preconsolidation_pressure") return MaterialParameter::preconsolidation_pressure;
   return std::nullopt;
 }
 
@@ -160,11 +162,14 @@ void read_material(ParseContext& c, const std::string& name, const json& j,
       // implicit schemes' scalings; by default the elastic E at p' = p'c
       // when p'c is a number, else at 100 kPa (docs/job-spec.md).
       if (!j.contains("youngs_modulus")) {
-        const double p_ref = j.contains("preconsolidation_pressure") &&
-                                     j["preconsolidation_pressure"].is_number() &&
-                                     j["preconsolidation_pressure"].get<double>() > 0
-                                 ? j["preconsolidation_pressure"].get<double>()
-                                 : 1e5;
+        // A random field's mean (its nominal value, read_varying) as p'c.
+        const bool pc_number = j.contains("preconsolidation_pressure") &&
+                               (j["preconsolidation_pressure"].is_number() ||
+                                j["preconsolidation_pressure"].is_object());
+        const double p_pc = pc_number && cc->preconsolidation_pressure
+                                ? cc->preconsolidation_pressure(Vec3{0.0, 0.0, 0.0})
+                                : 0.0;
+        const double p_ref = p_pc > 0 && std::isfinite(p_pc) ? p_pc : 1e5;
         if (cc->kappa > 0 && cc->initial_void_ratio > 0 && m.poisson_ratio < 0.5)
           m.youngs_modulus = 3.0 * (1.0 - 2.0 * m.poisson_ratio) * (1.0 + cc->initial_void_ratio) *
                              p_ref / cc->kappa;

@@ -114,15 +114,17 @@ using Plasticity = std::variant<LinearElastic, MohrCoulomb, DruckerPrager, Modif
 
 /// A material parameter that may vary from particle to particle (each has
 /// its output field of the same name, fields.hpp). Cam-Clay's
-/// preconsolidation pressure would join as the initial value of its state
-/// variable (materials/varying.hpp says where).
+/// preconsolidation pressure is the initial value of its state variable:
+/// its output is the state's field of that name (the particle's p'c as it
+/// hardens, the field's value until it yields).
 enum class MaterialParameter : std::uint8_t {
-  youngs_modulus,          ///< Pa
-  cohesion,                ///< Pa (mohr_coulomb, drucker_prager)
-  friction_angle,          ///< degrees (mohr_coulomb, drucker_prager)
-  hydraulic_conductivity,  ///< m/s (materials with hydraulic)
+  youngs_modulus,             ///< Pa
+  cohesion,                   ///< Pa (mohr_coulomb, drucker_prager)
+  friction_angle,             ///< degrees (mohr_coulomb, drucker_prager)
+  hydraulic_conductivity,     ///< m/s (materials with hydraulic)
+  preconsolidation_pressure,  ///< Pa (modified_cam_clay)
 };
-inline constexpr int material_parameter_count = 4;
+inline constexpr int material_parameter_count = 5;
 
 /// A parameter's value at each particle of a material: a spatially
 /// correlated random field (random_field.hpp) generated once, at set-up,

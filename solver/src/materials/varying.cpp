@@ -41,6 +41,8 @@ const char* parameter_name(MaterialParameter k) {
       return "friction_angle";
     case MaterialParameter::hydraulic_conductivity:
       return "hydraulic_conductivity";
+    case MaterialParameter::preconsolidation_pressure:
+      return "preconsolidation_pressure";
   }
   return "?";
 }
@@ -57,6 +59,12 @@ double parameter_of(const Material& m, MaterialParameter k) {
       with_strength(m, [&](const double& c, const double& phi) {
         out = k == MaterialParameter::cohesion ? c : phi;
       });
+      break;
+    case MaterialParameter::preconsolidation_pressure:
+      // A number (the parser's constant function, or set_parameter's);
+      // a formula's value at the origin, which no phase reads.
+      if (const auto* cc = std::get_if<ModifiedCamClay>(&m.plasticity))
+        if (cc->preconsolidation_pressure) out = cc->preconsolidation_pressure(Vec3{0.0, 0.0, 0.0});
       break;
   }
   return out;
@@ -75,6 +83,10 @@ void set_parameter(Material& m, MaterialParameter k, double value) {
       with_strength(
           m, [&](double& c, double& phi) { (k == MaterialParameter::cohesion ? c : phi) = value; });
       break;
+    case MaterialParameter::preconsolidation_pressure:
+      if (auto* cc = std::get_if<ModifiedCamClay>(&m.plasticity))
+        cc->preconsolidation_pressure = [value](const Vec3&) { return value; };
+      break;
   }
 }
 
@@ -88,6 +100,8 @@ bool parameter_applies(const Material& m, MaterialParameter k) {
     case MaterialParameter::friction_angle:
       return std::holds_alternative<MohrCoulomb>(m.plasticity) ||
              std::holds_alternative<DruckerPrager>(m.plasticity);
+    case MaterialParameter::preconsolidation_pressure:
+      return std::holds_alternative<ModifiedCamClay>(m.plasticity);
   }
   return false;
 }
@@ -96,6 +110,7 @@ std::string parameter_range_issue(MaterialParameter k, double value) {
   if (!std::isfinite(value)) return "is not a finite number";
   switch (k) {
     case MaterialParameter::youngs_modulus:
+    case MaterialParameter::preconsolidation_pressure:
       if (!(value > 0)) return "must be > 0";
       break;
     case MaterialParameter::cohesion:
@@ -140,7 +155,8 @@ std::vector<Field> default_snapshot_fields(const Problem& problem) {
                           std::holds_alternative<ModifiedCamClay>(m.plasticity));
     for (const Material& m : problem.materials)
       for (const VaryingParameter& v : m.varying)
-        wanted = wanted || v.parameter == parameter_of_field(f.field);
+        wanted = wanted || (is_material_parameter_field(f.field) &&
+                            v.parameter == parameter_of_field(f.field));
     if (wanted) out.push_back(f.field);
   }
   return out;

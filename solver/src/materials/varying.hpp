@@ -22,9 +22,10 @@
 // A new varying parameter: its MaterialParameter (problem.hpp) and output
 // field (fields.hpp), parameter_of/set_parameter/parameter_applies here,
 // what it derives in the set-up (Simulation::setup_varying, setup.hpp) and
-// the phases that read it. Cam-Clay's p'c would be the initial value of its
-// state variable (ParticleState::internal): set-up writes the particle's
-// value there instead of deriving a constant.
+// the phases that read it. Cam-Clay's p'c is the initial value of its
+// state variable (ParticleState::internal): initialise_cam_clay_state
+// (cam_clay_state.hpp) writes the particle's value there instead of
+// deriving a constant.
 #pragma once
 
 #include <array>
@@ -56,7 +57,8 @@ struct VaryingConstants {
   std::vector<double> permeability_over_gamma;  ///< k / (rho_f g): when k varies
 };
 
-/// The material parameter whose value a field is (is_material_parameter_field).
+/// The material parameter whose value a field is (is_material_parameter_field;
+/// p'c's field is Cam-Clay's state, not one of these).
 inline MaterialParameter parameter_of_field(Field f) {
   return static_cast<MaterialParameter>(static_cast<int>(f) -
                                         static_cast<int>(Field::youngs_modulus));
@@ -72,7 +74,8 @@ double parameter_of(const Material& m, MaterialParameter k);
 void set_parameter(Material& m, MaterialParameter k, double value);
 
 /// Whether the material has the parameter: E always, c and phi with a
-/// Mohr-Coulomb or Drucker-Prager model, k with hydraulic.
+/// Mohr-Coulomb or Drucker-Prager model, k with hydraulic, p'c with
+/// Modified Cam-Clay.
 bool parameter_applies(const Material& m, MaterialParameter k);
 
 /// "must be > 0", ... when `value` is outside the parameter's range; empty

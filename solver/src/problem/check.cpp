@@ -327,6 +327,17 @@ void check_body_materials(const Problem& problem, std::size_t i,
                ": the particles keep their mass and pore water, so the new material must have "
                "the same density, porosity and fluid density (change the model and its "
                "strength and stiffness parameters only)"});
+    // A random field's values are drawn at set-up for the particles of the
+    // bodies of its material then (materials/varying.hpp): a body that
+    // changes material later would keep the values of the one it left.
+    if (!to.varying.empty() || !from.varying.empty())
+      issues.push_back(
+          {at / "material",
+           "'" + (to.varying.empty() ? from.name : to.name) + "' has a parameter that varies (" +
+               parameter_name((to.varying.empty() ? from : to).varying.front().parameter) +
+               "), and a stage cannot switch a body to or from such a material: its values are "
+               "drawn at set-up for the bodies of the material then. Give the body that "
+               "material from the start, or make the parameter a number"});
   }
 }
 
