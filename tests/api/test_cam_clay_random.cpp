@@ -33,7 +33,7 @@ namespace {
 using json = nlohmann::json;  // NOLINT(readability-identifier-naming): nlohmann's own spelling
 
 constexpr int cells = 12;
-constexpr double height = 1.2, p0 = 1e5, load = 4e5;
+constexpr double height = 1.2, p0 = 1e5;  // the load, -1e5 - 3e5 min(t, 1), ends at 400 kPa
 
 json field(double theta) {
   return {{"random_field",
