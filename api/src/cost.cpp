@@ -33,14 +33,14 @@ std::int64_t to_count(double v) {
 // measurements once the schemes run (docs/performance.md).
 struct WallModel {
   /// A plastic material's return mapping, per particle-step.
-  static constexpr double plastic_factor = 1.5;
+  static constexpr double plastic_factor = 1.8;
   /// GIMP weights (the overlap of the particle's domain with each node's
   /// support) cost more than B-spline or linear ones.
   static constexpr double gimp_factor = 1.3;
   /// Per step whatever the size (phases, boundary values, progress).
   static constexpr double step_overhead = 12.0;
   /// Per run (set-up, first touch of the arrays, result files), seconds.
-  static constexpr double run_overhead_s = 2e-3;
+  static constexpr double run_overhead_s = 1e-3;
   /// Parallel efficiency once a run uses more than one thread.
   static constexpr double parallel_efficiency = 0.8;
   /// semi_implicit: assembling the pressure equation, per particle-step,
@@ -50,16 +50,29 @@ struct WallModel {
   /// dissection / preconditioned CG on a Laplacian-like matrix): the
   /// semi-implicit pressure equation.
   static constexpr double linear_solve = 0.1;
-  /// quasi_static, fitted on the soft-clay, real-water Terzaghi and 2D
-  /// embankment runs at 10k-400k particles (bench/schemes.sh,
-  /// docs/performance.md): Newton iterations per step (an elastic 1D step
-  /// converges in one, 2D steps took about three), assembling the u-p
-  /// tangent per particle and iteration, and the factorisation of the
-  /// saddle-point system, up_solve * (unknowns)^1.5.
-  static constexpr double newton_iterations_1d = 1.0;
-  static constexpr double newton_iterations = 3.0;
-  static constexpr double tangent_assembly = 60.0;
-  static constexpr double up_solve = 0.8;
+  /// quasi_static, fitted on the implicit examples (1 000-7 200 particles,
+  /// CHOLMOD's LDL^T; bench/estimate.sh, docs/performance.md "Wall-time
+  /// estimate"): linear solves per step (an elastic 1D step converges in
+  /// one; elastic 2D steps took 2.0-3.7, a solve and the one that checks
+  /// it, more where seepage faces or stages change; plastic steps about
+  /// 4), the u-p tangent's assembly per solve and implicit particle weight
+  /// (the explicit weight, its square root where above 1: a quadratic
+  /// B-spline plastic particle costs 1.4x a linear elastic one per solve,
+  /// not 3.4x, measured), a fixed part per solve (the factorisation's
+  /// set-up) and
+  /// the factorisation, up_solve * (unknowns)^1.5 (2D nested dissection).
+  static constexpr double solves_per_step_1d = 1.0;
+  static constexpr double solves_per_step = 2.5;
+  static constexpr double solves_per_plastic_step = 4.0;
+  static constexpr double tangent_assembly = 38.0;
+  static constexpr double solve_overhead = 150.0;
+  static constexpr double up_solve = 0.3;
+  /// strength_reduction: the factor of safety assumed before the run (a
+  /// typical slope's), the solves of a trial factor that converges and
+  /// the share of time.implicit.max_iterations a failing one spends (all:
+  /// failure is no convergence within them).
+  static constexpr double assumed_factor_of_safety = 1.5;
+  static constexpr double solves_per_converged_trial = 3.0;
 };
 
 /// Cost of one particle in reference particle-steps: the nodes it talks to
@@ -76,7 +89,9 @@ double particle_weight(const Problem& p, const Material& m) {
 /// The particles of every body weighted by their cost, and the count.
 struct Work {
   double weighted = 0.0;  ///< reference particle-steps per step
+  double implicit_weighted = 0.0;  ///< the quasi-static tangent's weight, per solve
   double particles = 0.0;
+  bool plastic = false;
 };
 
 Work particle_work(const Problem& p) {
@@ -92,7 +107,10 @@ Work particle_work(const Problem& p) {
                                 : Material{});
     const double n = static_cast<double>(count_particles(one));
     w.particles += n;
-    w.weighted += n * particle_weight(p, one.materials[0]);
+    const double weight = particle_weight(p, one.materials[0]);
+    w.weighted += n * weight;
+    w.implicit_weighted += n * (weight > 1 ? std::sqrt(weight) : weight);
+    w.plastic = w.plastic || (n > 0 && !std::holds_alternative<LinearElastic>(one.materials[0].plasticity));
   }
   return w;
 }
@@ -112,13 +130,26 @@ double solver_threads(double particles, int threads) {
   return std::clamp(usable, 1.0, static_cast<double>(std::max(threads, 1)));
 }
 
+/// Linear solves per quasi-static step.
+double quasi_static_solves(const Problem& p, const Work& w) {
+  if (w.plastic) return WallModel::solves_per_plastic_step;
+  return p.dimension == 1 ? WallModel::solves_per_step_1d : WallModel::solves_per_step;
+}
+
+/// One quasi-static linear solve: the tangent's assembly, the fixed part
+/// and the factorisation, in reference particle-steps.
+double quasi_static_solve(const Problem& p, const Work& w, double speedup) {
+  const int d = std::clamp(p.dimension, 1, 3);
+  return WallModel::tangent_assembly * w.implicit_weighted / speedup + WallModel::solve_overhead +
+         WallModel::up_solve * std::pow(grid_nodes(p) * (d + 1), 1.5);
+}
+
 /// Expected wall time of `steps` steps of `scheme`.
 double wall_seconds(const Problem& p, Scheme scheme, double steps, const Calibration& cal) {
   const Work w = particle_work(p);
   const double threads = solver_threads(w.particles, cal.threads);
   const double speedup = threads > 1 ? threads * WallModel::parallel_efficiency : 1.0;
   const double explicit_step = w.weighted / speedup + WallModel::step_overhead;
-  const int d = std::clamp(p.dimension, 1, 3);
   const double nodes = grid_nodes(p);
   double per_step = explicit_step;
   switch (scheme) {
@@ -129,13 +160,30 @@ double wall_seconds(const Problem& p, Scheme scheme, double steps, const Calibra
                   WallModel::linear_solve * std::pow(nodes, 1.5);
       break;
     case Scheme::quasi_static:
-      per_step = (d == 1 ? WallModel::newton_iterations_1d : WallModel::newton_iterations) *
-                     (WallModel::tangent_assembly * w.weighted / speedup +
-                      WallModel::up_solve * std::pow(nodes * (d + 1), 1.5)) +
+      per_step = quasi_static_solves(p, w) * quasi_static_solve(p, w, speedup) +
                  WallModel::step_overhead;
       break;
   }
-  return WallModel::run_overhead_s + steps * per_step * cal.seconds_per_particle_step;
+  double work = steps * per_step;
+  // strength_reduction (quasi-static, after the last stage): trial factors
+  // from F = 1 in steps of `increment` up to the assumed factor of safety,
+  // then a bisection of ceil(log2(increment / resolution)) trials; about
+  // half of the bisection's trials converge (a few solves each), and each
+  // failing trial spends time.implicit.max_iterations solves.
+  if (p.strength_reduction && scheme == Scheme::quasi_static) {
+    const StrengthReduction& sr = *p.strength_reduction;
+    const double f = std::min(WallModel::assumed_factor_of_safety, sr.max_factor);
+    const double bisections =
+        std::max(0.0, std::ceil(std::log2(sr.increment / sr.resolution) - 1e-9));
+    const double converged = 1 + std::ceil((f - 1) / sr.increment - 1e-9) + bisections / 2;
+    const double failed = f < sr.max_factor ? bisections : 0.0;
+    Work plastic = w;
+    plastic.plastic = true;
+    work += (converged * WallModel::solves_per_converged_trial +
+             failed * std::max(1, p.time.implicit.max_iterations)) *
+            quasi_static_solve(p, plastic, speedup);
+  }
+  return WallModel::run_overhead_s + work * cal.seconds_per_particle_step;
 }
 
 // --------------------------------------------------- what limits each step
@@ -407,13 +455,23 @@ CostEstimate estimate_cost(const Problem& p, const Calibration& calibration) {
   c.nodes = to_count(nodes);
   const StableStep step = stable_step(p);
   c.dt = step.chosen;
-  // A staged job: the steps of every stage, to the last one's end.
+  // A staged job: the steps of every stage, to the last one's end, and
+  // the wall time of each stage in its own scheme with its own bodies.
   double steps = static_cast<double>(step.steps);
   double job_end = p.time.end;
-  for (std::size_t k = 1; k < stage_count(p); ++k) {
-    const Problem stage = stage_problem(p, k);
-    steps += static_cast<double>(std::max<std::int64_t>(1, stable_step(stage).steps));
-    job_end = stage.time.end;
+  double wall = 0;
+  const std::size_t stages = stage_count(p);
+  for (std::size_t k = 0; k < stages; ++k) {
+    Problem stage = k == 0 ? p : stage_problem(p, k);
+    const double stage_steps =
+        k == 0 ? steps : static_cast<double>(std::max<std::int64_t>(1, stable_step(stage).steps));
+    if (k > 0) {
+      steps += stage_steps;
+      job_end = stage.time.end;
+    }
+    if (k + 1 < stages) stage.strength_reduction.reset();  // after the last stage only
+    wall += wall_seconds(stage, stage.time.scheme, stage_steps, calibration) -
+            (k > 0 ? WallModel::run_overhead_s : 0.0);
   }
   c.steps = to_count(steps);
   c.particle_steps = to_count(static_cast<double>(c.particles) * steps);
@@ -451,7 +509,7 @@ CostEstimate estimate_cost(const Problem& p, const Calibration& calibration) {
 
   c.scheme = p.time.scheme;
   c.calibration = calibration;
-  c.wall_seconds = wall_seconds(p, p.time.scheme, steps, calibration);
+  c.wall_seconds = wall;
   for (Scheme s : {Scheme::explicit_scheme, Scheme::semi_implicit, Scheme::quasi_static})
     c.schemes.push_back(s == p.time.scheme
                             ? SchemeCost{s, c.steps, c.dt, step.fixed, c.wall_seconds}
