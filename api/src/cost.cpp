@@ -88,7 +88,7 @@ double particle_weight(const Problem& p, const Material& m) {
 
 /// The particles of every body weighted by their cost, and the count.
 struct Work {
-  double weighted = 0.0;  ///< reference particle-steps per step
+  double weighted = 0.0;           ///< reference particle-steps per step
   double implicit_weighted = 0.0;  ///< the quasi-static tangent's weight, per solve
   double particles = 0.0;
   bool plastic = false;
@@ -110,7 +110,8 @@ Work particle_work(const Problem& p) {
     const double weight = particle_weight(p, one.materials[0]);
     w.weighted += n * weight;
     w.implicit_weighted += n * (weight > 1 ? std::sqrt(weight) : weight);
-    w.plastic = w.plastic || (n > 0 && !std::holds_alternative<LinearElastic>(one.materials[0].plasticity));
+    w.plastic =
+        w.plastic || (n > 0 && !std::holds_alternative<LinearElastic>(one.materials[0].plasticity));
   }
   return w;
 }
@@ -160,8 +161,8 @@ double wall_seconds(const Problem& p, Scheme scheme, double steps, const Calibra
                   WallModel::linear_solve * std::pow(nodes, 1.5);
       break;
     case Scheme::quasi_static:
-      per_step = quasi_static_solves(p, w) * quasi_static_solve(p, w, speedup) +
-                 WallModel::step_overhead;
+      per_step =
+          quasi_static_solves(p, w) * quasi_static_solve(p, w, speedup) + WallModel::step_overhead;
       break;
   }
   double work = steps * per_step;
