@@ -23,7 +23,8 @@ namespace {
 template <class Shape>
 RunResult run_checked(const Problem& problem, const RunOptions& options) {
   try {
-    Simulation<HMPM_DIM, Shape> simulation(problem, options);
+    const Problem regularised = regularise_softening(problem);  // lives as long as the run
+    Simulation<HMPM_DIM, Shape> simulation(regularised, options);
     return simulation.run(options);
   } catch (const SetupInterrupted& stop) {
     RunResult result;

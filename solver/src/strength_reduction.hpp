@@ -5,7 +5,8 @@
 // loads of the job's end held: the strength of every Mohr-Coulomb and
 // Drucker-Prager material is divided by F,
 //   c_F = c / F,   tan(phi_F) = tan(phi) / F,   psi_F = min(psi, phi_F),
-// the tensile strength by F as well (a particle's own c and phi where they
+// the tensile strength by F as well, and a softening material's residual
+// c and phi alike (a particle's own c and phi where they
 // are random fields), and the quasi-static scheme looks for
 // equilibrium from the converged state at the previous F
 // (QuasiStaticScheme::strength_reduce: Newton with the consistent tangent,
@@ -51,6 +52,16 @@ inline Material reduced_strength(Material m, double factor) {
           model.friction_angle_deg =
               std::atan(std::tan(model.friction_angle_deg * degree) / factor) / degree;
           model.dilatancy_angle_deg = std::min(model.dilatancy_angle_deg, model.friction_angle_deg);
+        }
+        if constexpr (std::is_same_v<T, MohrCoulomb>) {
+          if (model.softening) {  // the residual strength is reduced alike
+            MohrCoulomb::Softening& s = *model.softening;
+            s.residual_cohesion /= factor;
+            s.residual_friction_angle_deg =
+                std::atan(std::tan(s.residual_friction_angle_deg * degree) / factor) / degree;
+            s.residual_dilatancy_angle_deg =
+                std::min(s.residual_dilatancy_angle_deg, s.residual_friction_angle_deg);
+          }
         }
       },
       m.plasticity);

@@ -80,6 +80,22 @@ struct MohrCoulomb {
   double dilatancy_angle_deg = 0.0;
   double cohesion = 0.0;          ///< Pa
   double tensile_strength = 0.0;  ///< Pa; cut-off on the major principal stress
+  /// Exponential strain softening from the values above (the peak) to the
+  /// residual ones: X = X_r + (X_p - X_r) exp(-shape_factor kappa), kappa
+  /// the particle's accumulated equivalent plastic strain under this
+  /// material. reference_cell_size > 0 regularises it: the shape factor is
+  /// shape_factor h / reference_cell_size on a grid of cell size h (the
+  /// geometric mean of the cell's sides), so that the displacement across
+  /// a shear band (about one cell wide) that softens the soil, and the
+  /// energy dissipated per unit band length, do not change with the grid.
+  struct Softening {
+    double residual_cohesion = 0.0;             ///< Pa
+    double residual_friction_angle_deg = 0.0;   ///< degrees
+    double residual_dilatancy_angle_deg = 0.0;  ///< degrees
+    double shape_factor = 0.0;                  ///< eta, per unit plastic strain
+    double reference_cell_size = 0.0;           ///< m; 0: not regularised
+  };
+  std::optional<Softening> softening = std::nullopt;
 };
 
 /// Drucker-Prager fitted to Mohr-Coulomb (plane-strain match). Angles in degrees.

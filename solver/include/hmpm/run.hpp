@@ -104,6 +104,15 @@ inline std::size_t stage_count(const Problem& problem) {
 /// stage_bodies says which have particles.
 Problem stage_problem(const Problem& problem, std::size_t k);
 
+/// The cell size strain softening is regularised with: the geometric mean
+/// of a cell's sides in the problem's dimension.
+double softening_cell_size(const Problem& problem);
+
+/// `problem` with every regularised softening (Softening::reference_cell_size
+/// > 0) applied: its shape factor times softening_cell_size / the reference,
+/// the reference then 0. A run does this once, before it sets up.
+Problem regularise_softening(const Problem& problem);
+
 /// Per body: whether its particles are in the run during stage k (a body
 /// some stage adds is absent before that stage; a removed one from its
 /// stage on).

@@ -14,7 +14,8 @@
 // largest count among the materials that have particles) and the stress
 // update hands the model its particle's slots (InternalState). Linear
 // elasticity, Mohr-Coulomb and Drucker-Prager declare none; Modified
-// Cam-Clay keeps two (the void ratio and p'c, modified_cam_clay.hpp).
+// Cam-Clay keeps two (the void ratio and p'c, modified_cam_clay.hpp), a
+// softening Mohr-Coulomb material one (its softening strain).
 #pragma once
 
 #include <cmath>
@@ -46,7 +47,9 @@ constexpr bool elastic_trial_outside(Model m) {
   return m != Model::modified_cam_clay;
 }
 
-/// Number of per-particle internal state variables the model keeps.
+/// Number of per-particle internal state variables the model keeps (a
+/// softening Mohr-Coulomb material keeps one more: see the overload on
+/// MaterialConstants below).
 constexpr int state_variable_count(Model m) {
   switch (m) {
     case Model::mohr_coulomb:
@@ -90,6 +93,13 @@ struct MaterialConstants {
   double permeability_over_gamma = 0.0;  ///< k / (rho_f g), m^3 s / kg
   double darcy_inertia_density = 0.0;    ///< rho_f, or 0 when Darcy's rho_f a is dropped
 };
+
+/// Number of per-particle internal state variables material `c` keeps.
+inline int state_variable_count(const MaterialConstants& c) {
+  if (c.model == Model::mohr_coulomb && c.mohr_coulomb.softens)
+    return constitutive::MohrCoulombModel::softening_state_variables;
+  return state_variable_count(c.model);
+}
 
 inline MaterialConstants material_constants(const Material& m, double gravity_constant) {
   MaterialConstants c;
@@ -147,6 +157,21 @@ inline double update_cam_clay(constitutive::Voigt& sig, const constitutive::Voig
   return plastic;
 }
 
+/// Mohr-Coulomb's return for particle p's constants `mc` (softening ones
+/// read and, when state.commit, write its softening strain).
+inline double update_mohr_coulomb(constitutive::Voigt& sig, const constitutive::Elastic& el,
+                                  const constitutive::MohrCoulombConstants& mc, InternalState state,
+                                  constitutive::Tangent* d_alg) {
+  if (!mc.softens)
+    return d_alg ? constitutive::return_mohr_coulomb_with_tangent(sig, el, mc, *d_alg)
+                 : constitutive::return_mohr_coulomb(sig, el, mc);
+  using M = constitutive::MohrCoulombModel;
+  double kappa = state[M::softening_slot];
+  const double plastic = constitutive::return_mohr_coulomb_softening(sig, el, mc, kappa, d_alg);
+  if (state.commit) state[M::softening_slot] = kappa;
+  return plastic;
+}
+
 /// Plastic correction of the elastic trial stress (effective stress, so dry
 /// and saturated alike): the closed-form return mapping of the material's
 /// model; linear-elastic materials in a run with plastic ones pass through.
@@ -166,8 +191,9 @@ inline double return_to_yield_surface(constitutive::Voigt& sig,
                                       [[maybe_unused]] InternalState state) {
   switch (mc.model) {
     case Model::mohr_coulomb:
-      return constitutive::return_mohr_coulomb(
-          sig, el, varying.mohr_coulomb.empty() ? mc.mohr_coulomb : varying.mohr_coulomb[p]);
+      return update_mohr_coulomb(
+          sig, el, varying.mohr_coulomb.empty() ? mc.mohr_coulomb : varying.mohr_coulomb[p], state,
+          nullptr);
     case Model::drucker_prager:
       return constitutive::return_drucker_prager(
           sig, el, varying.drucker_prager.empty() ? mc.drucker_prager : varying.drucker_prager[p]);
@@ -242,8 +268,9 @@ inline double return_with_tangent(constitutive::Voigt& sig,
                                   constitutive::Tangent& d_alg) {
   switch (mc.model) {
     case Model::mohr_coulomb:
-      return constitutive::return_mohr_coulomb_with_tangent(
-          sig, el, varying.mohr_coulomb.empty() ? mc.mohr_coulomb : varying.mohr_coulomb[p], d_alg);
+      return update_mohr_coulomb(
+          sig, el, varying.mohr_coulomb.empty() ? mc.mohr_coulomb : varying.mohr_coulomb[p], state,
+          &d_alg);
     case Model::drucker_prager:
       return constitutive::return_drucker_prager_with_tangent(
           sig, el, varying.drucker_prager.empty() ? mc.drucker_prager : varying.drucker_prager[p],

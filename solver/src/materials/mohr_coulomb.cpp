@@ -285,3 +285,106 @@ double return_mohr_coulomb_with_tangent(Voigt& stress, const Elastic& el,
 }
 
 }  // namespace hmpm::constitutive
+
+namespace hmpm::constitutive {
+
+double return_mohr_coulomb_softening(Voigt& stress, const Elastic& el,
+                                     const MohrCoulombConstants& peak, double& kappa,
+                                     Tangent* d_alg) {
+  const double kappa_n = std::max(kappa, 0.0);
+  const MohrCoulombConstants start = softened(peak, kappa_n);
+  const Voigt trial_stress = stress;
+  if (return_mohr_coulomb(stress, el, start) == 0.0) {  // elastic at the step's start
+    if (d_alg != nullptr) *d_alg = elastic_tangent(el);
+    return 0.0;
+  }
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig;
+  eig.computeDirect(detail::to_tensor(trial_stress));
+  const Eigen::Vector3d& ev = eig.eigenvalues();     // ascending
+  const Eigen::Vector3d trial(ev(2), ev(1), ev(0));  // s1 >= s2 >= s3
+  const double scale = trial.cwiseAbs().maxCoeff() + peak.cohesion;
+  const double tol = 1e-13 * scale;
+  constexpr double root_two_thirds = 0.816496580927726;
+  // The principal return at softening strain k, and its softening strain.
+  const auto principal = [&](double k, Eigen::Vector3d& r) {
+    const MohrCoulombConstants c = softened(peak, k);
+    const double f = c.planes[0].normal.dot(trial) - c.planes[0].offset;
+    if (f <= 0.0 && trial(0) <= c.tension_cutoff) {
+      r = trial;
+      return 0.0;
+    }
+    r = detail::mohr_coulomb_principal(trial, el, c, tol);
+    return root_two_thirds * detail::compliance_times(el, trial - r).norm();
+  };
+  // F(k) = k - kappa_n - g(k): F(kappa_n) < 0; at the residual strength g
+  // is largest, so F(kappa_n + g_residual) >= 0 (g grows as the soil softens).
+  Eigen::Vector3d r;
+  const double g_start = principal(kappa_n, r);
+  double lo = kappa_n, f_lo = -g_start;
+  Eigen::Vector3d r_res;
+  const double g_res = principal(std::numeric_limits<double>::infinity(), r_res);
+  double hi = kappa_n + g_res, f_hi = hi - kappa_n - principal(hi, r);
+  double k = hi;
+  const double k_tol = 1e-14 * std::max(hi, 1.0 / std::max(peak.shape_factor, 1e-300)) + 1e-300;
+  if (f_hi > 0.0) {
+    // Illinois (regula falsi that halves the stale end's weight).
+    int side = 0;
+    for (int it = 0; it < 100 && hi - lo > k_tol; ++it) {
+      k = (lo * f_hi - hi * f_lo) / (f_hi - f_lo);
+      if (!(k > lo && k < hi)) k = 0.5 * (lo + hi);
+      const double fk = k - kappa_n - principal(k, r);
+      if (fk == 0.0) break;
+      if (fk < 0.0) {
+        lo = k, f_lo = fk;
+        if (side == -1) f_hi *= 0.5;
+        side = -1;
+      } else {
+        hi = k, f_hi = fk;
+        if (side == 1) f_lo *= 0.5;
+        side = 1;
+      }
+    }
+  }
+  kappa = kappa_n + principal(k, r);
+  // The stress at kappa_{n+1}'s constants (bit for bit what the tangent's
+  // return below gives, so both paths agree).
+  const MohrCoulombConstants end = softened(peak, kappa);
+  stress = trial_stress;
+  if (d_alg == nullptr) return return_mohr_coulomb(stress, el, end);
+  // The stress and its tangent at fixed kappa (the same return at `end`).
+  Tangent d_kappa;
+  const double plastic = return_mohr_coulomb_with_tangent(stress, el, end, d_kappa);
+  // d sigma / d kappa and d g / d kappa: central differences of the
+  // principal return (the trial, hence its eigenvectors, is fixed).
+  const double h = 1e-6 * std::max(kappa, 1.0 / std::max(peak.shape_factor, 1e-300));
+  Eigen::Vector3d r_plus, r_minus;
+  const double g_plus = principal(kappa + h, r_plus);
+  const double g_minus = principal(std::max(kappa - h, 0.0), r_minus);
+  const double width = kappa + h - std::max(kappa - h, 0.0);
+  const double dg_dk = (g_plus - g_minus) / width;
+  const Eigen::Vector3d dr_desc = (r_plus - r_minus) / width;
+  const Eigen::Matrix3d& v = eig.eigenvectors();
+  const Eigen::Matrix3d dm =
+      v * Eigen::Vector3d(dr_desc(2), dr_desc(1), dr_desc(0)).asDiagonal() * v.transpose();
+  Voigt dsig_dk;
+  dsig_dk << dm(0, 0), dm(1, 1), dm(2, 2), dm(0, 1), dm(1, 2), dm(0, 2);
+  // d g / d eps: g = sqrt(2/3) |d eps_p|, d eps_p = C (sigma_tr - sigma), so
+  // d(d eps_p)/d eps = I - C D_kappa; |.| is the tensor norm (shears twice).
+  const Tangent compliance = elastic_tangent(el).inverse();
+  const Voigt deps_p = compliance * (trial_stress - stress);
+  const double norm =
+      std::sqrt(deps_p.head<3>().squaredNorm() + 2.0 * deps_p.tail<3>().squaredNorm());
+  Eigen::Matrix<double, 1, 6> dg_de = Eigen::Matrix<double, 1, 6>::Zero();
+  if (norm > 0.0) {
+    Voigt weighted = deps_p;
+    weighted.tail<3>() *= 2.0;
+    dg_de = root_two_thirds / norm * weighted.transpose() *
+            (Tangent::Identity() - compliance * d_kappa);
+  }
+  const double denominator = 1.0 - dg_dk;
+  *d_alg = d_kappa;
+  if (std::abs(denominator) > 1e-12) *d_alg += dsig_dk * (dg_de / denominator);
+  return plastic;
+}
+
+}  // namespace hmpm::constitutive

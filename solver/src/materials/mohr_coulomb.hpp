@@ -50,6 +50,20 @@ struct MohrCoulombConstants {
   /// s1 = s2; F3 (s1, s2), which meets F1 on the triaxial extension edge
   /// s2 = s3; then the cut-off planes s1, s2, s3 <= sigma_t (associated).
   std::array<PrincipalPlane, 6> planes;
+
+  // Strain softening (MohrCoulomb::softening): c, phi and psi go from the
+  // peak values above to the residual ones as X = X_r + (X_p - X_r)
+  // exp(-shape_factor kappa), kappa the particle's accumulated equivalent
+  // plastic strain under this material (its one state variable). softened()
+  // makes the constants at a kappa from these.
+  bool softens = false;
+  double friction = 0.0;          ///< phi, radians (the peak)
+  double dilatancy = 0.0;         ///< psi, radians, clamped into [0, phi] (the peak)
+  double tensile_strength = 0.0;  ///< as given (>= 0); the cut-off is min(it, apex)
+  double residual_cohesion = 0.0;
+  double residual_friction = 0.0;   ///< radians
+  double residual_dilatancy = 0.0;  ///< radians, clamped into [0, residual phi]
+  double shape_factor = 0.0;        ///< eta, regularised for the cell size where asked
 };
 
 namespace detail {
@@ -80,23 +94,21 @@ Eigen::Vector3d mohr_coulomb_principal(const Eigen::Vector3d& trial, const Elast
 /// cut-off is sigma_t = min(max(tensile_strength, 0), c cot phi), so the
 /// default tensile_strength = 0 means "no tension" (and sigma_t is the apex
 /// when c = 0). phi = 0 gives Tresca with no apex.
-inline MohrCoulombConstants make_mohr_coulomb(const hmpm::MohrCoulomb& m) {
+/// The constants of angles phi, psi (radians; psi already within [0, phi]),
+/// cohesion c and tensile strength (>= 0), without softening.
+inline MohrCoulombConstants mohr_coulomb_constants(double phi, double psi, double cohesion,
+                                                   double tensile_strength) {
   MohrCoulombConstants c;
-  // The angle as given, in [0, 90] (the job spec refuses 90 and above; 89
-  // was the clamp once). Up to 89.999 degrees the return lands on the
-  // surface to rounding, except the Mohr-Coulomb corner of the main plane
-  // and a cut-off below the apex, nearly parallel there: |f| up to 2e-5 of
-  // the trial (tests/solver/test_constitutive.cpp, steep angles).
-  const double phi = std::clamp(m.friction_angle_deg, 0.0, 90.0) * detail::deg_to_rad;
-  const double psi =
-      std::clamp(m.dilatancy_angle_deg, 0.0, phi / detail::deg_to_rad) * detail::deg_to_rad;
+  c.friction = phi;
+  c.dilatancy = psi;
   c.sin_phi = std::sin(phi);
   c.cos_phi = std::cos(phi);
   c.sin_psi = std::sin(psi);
-  c.cohesion = std::max(m.cohesion, 0.0);
+  c.cohesion = std::max(cohesion, 0.0);
+  c.tensile_strength = std::max(tensile_strength, 0.0);
   c.apex = c.sin_phi > 0.0 ? c.cohesion * c.cos_phi / c.sin_phi
                            : std::numeric_limits<double>::infinity();
-  c.tension_cutoff = std::min(std::max(m.tensile_strength, 0.0), c.apex);
+  c.tension_cutoff = std::min(c.tensile_strength, c.apex);
   const double sp = c.sin_phi, ss = c.sin_psi, k = 2.0 * c.cohesion * c.cos_phi;
   c.planes[0] = {{1 + sp, 0, -(1 - sp)}, {1 + ss, 0, -(1 - ss)}, k};
   c.planes[1] = {{0, 1 + sp, -(1 - sp)}, {0, 1 + ss, -(1 - ss)}, k};
@@ -105,6 +117,48 @@ inline MohrCoulombConstants make_mohr_coulomb(const hmpm::MohrCoulomb& m) {
     c.planes[3 + i].normal = Eigen::Vector3d::Unit(i);
     c.planes[3 + i].flow = Eigen::Vector3d::Unit(i);
     c.planes[3 + i].offset = c.tension_cutoff;
+  }
+  return c;
+}
+
+/// The constants of a softening material at softening strain kappa >= 0
+/// (peak.softens; the peak itself at kappa = 0, the residual as kappa grows).
+/// The tension cut-off stays the given tensile strength, at most the
+/// softened apex c cot phi.
+inline MohrCoulombConstants softened(const MohrCoulombConstants& peak, double kappa) {
+  if (!(kappa > 0.0)) return peak;
+  const double w = std::isinf(kappa) ? 0.0 : std::exp(-peak.shape_factor * kappa);
+  const auto mix = [w](double p, double r) { return r + (p - r) * w; };
+  MohrCoulombConstants c = mohr_coulomb_constants(
+      mix(peak.friction, peak.residual_friction), mix(peak.dilatancy, peak.residual_dilatancy),
+      mix(peak.cohesion, peak.residual_cohesion), peak.tensile_strength);
+  c.softens = true;
+  c.residual_cohesion = peak.residual_cohesion;
+  c.residual_friction = peak.residual_friction;
+  c.residual_dilatancy = peak.residual_dilatancy;
+  c.shape_factor = peak.shape_factor;
+  return c;
+}
+
+inline MohrCoulombConstants make_mohr_coulomb(const hmpm::MohrCoulomb& m) {
+  // The angle as given, in [0, 90] (the job spec refuses 90 and above; 89
+  // was the clamp once). Up to 89.999 degrees the return lands on the
+  // surface to rounding, except the Mohr-Coulomb corner of the main plane
+  // and a cut-off below the apex, nearly parallel there: |f| up to 2e-5 of
+  // the trial (tests/solver/test_constitutive.cpp, steep angles).
+  const double phi = std::clamp(m.friction_angle_deg, 0.0, 90.0) * detail::deg_to_rad;
+  const double psi =
+      std::clamp(m.dilatancy_angle_deg, 0.0, phi / detail::deg_to_rad) * detail::deg_to_rad;
+  MohrCoulombConstants c = mohr_coulomb_constants(phi, psi, m.cohesion, m.tensile_strength);
+  if (m.softening) {
+    const hmpm::MohrCoulomb::Softening& s = *m.softening;
+    c.softens = true;
+    c.residual_cohesion = std::max(s.residual_cohesion, 0.0);
+    const double phi_r = std::clamp(s.residual_friction_angle_deg, 0.0, 90.0);
+    c.residual_friction = phi_r * detail::deg_to_rad;
+    c.residual_dilatancy =
+        std::clamp(s.residual_dilatancy_angle_deg, 0.0, phi_r) * detail::deg_to_rad;
+    c.shape_factor = std::max(s.shape_factor, 0.0);
   }
   return c;
 }
@@ -141,12 +195,31 @@ double return_mohr_coulomb(Voigt& stress, const Elastic& el, const MohrCoulombCo
 double return_mohr_coulomb_with_tangent(Voigt& stress, const Elastic& el,
                                         const MohrCoulombConstants& mc, Tangent& d_alg);
 
+/// Strain-softening Mohr-Coulomb return: `peak` softens (peak.softens),
+/// `kappa` is the particle's softening strain at the step's start on entry
+/// and at its end on exit. Implicit in kappa: the returned stress lies on
+/// the yield surface of softened(peak, kappa_{n+1}), with
+/// kappa_{n+1} = kappa_n + sqrt(2/3) ||d eps_p|| (a scalar equation solved
+/// by a bracketed secant iteration around the closed-form return; the
+/// trial's eigen decomposition is done once). `d_alg`, when given, receives
+/// the algorithmic tangent including kappa's dependence on the strain:
+/// D = D_kappa + (d sigma/d kappa) (x) (d kappa/d eps), d kappa/d eps =
+/// (d g/d eps) / (1 - d g/d kappa), g the step's softening strain at fixed
+/// kappa (d/d kappa by central differences of the principal return, d/d eps
+/// from D_kappa, the tangent at fixed kappa). Returns ||d eps_p||.
+double return_mohr_coulomb_softening(Voigt& stress, const Elastic& el,
+                                     const MohrCoulombConstants& peak, double& kappa,
+                                     Tangent* d_alg);
+
 /// The model as the stress update sees it: its constants, its return
 /// mapping and the number of per-particle internal state variables it keeps
-/// (ParticleState::internal). Perfectly plastic: none.
+/// (ParticleState::internal). Perfectly plastic: none; with softening one,
+/// the softening strain kappa (slot 0).
 struct MohrCoulombModel {
   using Constants = MohrCoulombConstants;
   static constexpr int state_variables = 0;
+  static constexpr int softening_state_variables = 1;
+  static constexpr int softening_slot = 0;
   static inline void return_stress(Voigt& sig, const Elastic& el, const Constants& c) {
     return_mohr_coulomb(sig, el, c);
   }
