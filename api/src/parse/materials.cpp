@@ -10,7 +10,8 @@
 namespace hmpm::api::parse {
 namespace {
 
-// Keys every material reads; the model's parameters and "hydraulic" follow.
+// Keys every material reads; the model's parameters, "hydraulic" and
+// "softening" (softening.cpp) follow.
 constexpr std::string_view material_common_allowed[] = {"model", "density", "youngs_modulus",
                                                         "poisson_ratio"};
 // youngs_modulus too, except for modified_cam_clay (read_material).
@@ -28,6 +29,7 @@ Keys material_key_names() {
                                       std::end(material_common_allowed));
     for (std::string_view k : model_parameter_keys()) out.push_back(k);
     out.push_back("hydraulic");
+    out.push_back("softening");
     return out;
   }();
   return keys;
@@ -177,6 +179,7 @@ void read_material(ParseContext& c, const std::string& name, const json& j,
     } else if (!j.contains("youngs_modulus")) {
       r.error(child_pointer(path, "youngs_modulus"), "is required");
     }
+    if (j.contains("softening")) read_softening(c, m, j["softening"], path + "/softening");
     if (j.contains("hydraulic")) read_hydraulic(c, m, j["hydraulic"], path + "/hydraulic");
   }
   c.material_index[name] = static_cast<int>(c.p.materials.size());
@@ -188,6 +191,7 @@ void read_material(ParseContext& c, const std::string& name, const json& j,
 void material_keys(std::vector<SpecObjectKeys>& out) {
   out.push_back(keys_entry("/materials/*", material_key_names()));
   out.push_back(keys_entry("/materials/*/hydraulic", hydraulic_allowed));
+  softening_keys(out);
 }
 
 void read_materials(ParseContext& c, const json& j, const std::string& path) {

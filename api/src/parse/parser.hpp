@@ -114,6 +114,9 @@ void read_materials(ParseContext& c, const json& j, const std::string& path);
 /// A material parameter given as {"random_field": {...}} (random_fields.cpp).
 std::optional<RandomField> read_random_field(ParseContext& c, const json& j,
                                              const std::string& path);
+/// A Mohr-Coulomb material's "softening" (softening.cpp); `m` has its model.
+void read_softening(ParseContext& c, Material& m, const json& j, const std::string& path);
+void softening_keys(std::vector<SpecObjectKeys>& out);
 void read_bodies(ParseContext& c, const json& j, const std::string& path);
 /// A material's name (a body's, a stage's body_materials'): its index, or
 /// an error at `path` naming the defined ones.

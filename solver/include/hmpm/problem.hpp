@@ -94,6 +94,9 @@ struct MohrCoulomb {
     double residual_dilatancy_angle_deg = 0.0;  ///< degrees
     double shape_factor = 0.0;                  ///< eta, per unit plastic strain
     double reference_cell_size = 0.0;           ///< m; 0: not regularised
+    /// Set by regularise_softening (hmpm/run.hpp): shape_factor is already
+    /// the regularised one.
+    bool regularised = false;
   };
   std::optional<Softening> softening = std::nullopt;
 };

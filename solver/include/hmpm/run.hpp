@@ -109,8 +109,9 @@ Problem stage_problem(const Problem& problem, std::size_t k);
 double softening_cell_size(const Problem& problem);
 
 /// `problem` with every regularised softening (Softening::reference_cell_size
-/// > 0) applied: its shape factor times softening_cell_size / the reference,
-/// the reference then 0. A run does this once, before it sets up.
+/// > 0) applied: its shape factor times softening_cell_size / the reference
+/// (marked `regularised`, so applying it again changes nothing). A run does
+/// this before it sets up.
 Problem regularise_softening(const Problem& problem);
 
 /// Per body: whether its particles are in the run during stage k (a body

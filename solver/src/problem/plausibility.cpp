@@ -11,6 +11,7 @@
 #include <string>
 
 #include "hmpm/format.hpp"
+#include "hmpm/run.hpp"
 #include "materials/material.hpp"
 #include "particle_layout.hpp"
 
@@ -204,6 +205,32 @@ std::vector<ProblemIssue> material_plausibility(const Problem& problem) {
     check_range(m.density, m.hydraulic ? grain_density_range : bulk_density_range, w, out);
     check_poisson(m, w, out);
     check_strength(m, w, out);
+    if (const auto* mc = std::get_if<MohrCoulomb>(&m.plasticity); mc && mc->softening) {
+      const MohrCoulomb::Softening& s = *mc->softening;
+      // Without the regularisation the plastic strain localises in a band
+      // about a cell wide, so the softening (and a runout) follows the grid.
+      if (s.reference_cell_size <= 0)
+        out.push_back({w / "softening",
+                       "has no reference_cell_size: the plastic strain of a shear band "
+                       "concentrates in about one cell, so the strength drop, the failure "
+                       "load and the runout change with the grid. What to change: set "
+                       "reference_cell_size to the cell size the shape_factor was calibrated "
+                       "for (e.g. the cell size of this grid, " +
+                           format4(softening_cell_size(problem)) +
+                           " m): the shape factor then scales with the cell size and the "
+                           "softening displacement across a band stays the same"});
+      // Softened within a strain the elastic range already spans: a snap
+      // back at the point (the return still converges; the run is brittle).
+      const double drop = mc->cohesion - s.residual_cohesion;
+      if (s.shape_factor > 1e4 && drop >= 0)
+        out.push_back({w / "softening" / "shape_factor",
+                       "is " + format4(s.shape_factor) +
+                           ": the strength drops within a plastic strain of " +
+                           format4(3.0 / s.shape_factor) +
+                           ", close to a brittle jump; the answer then depends strongly on the "
+                           "step and the grid. What to change: a shape factor of 5-100 (95 % "
+                           "of the drop at a plastic strain of 3/shape_factor)"});
+    }
     if (m.hydraulic) {
       const Hydraulic& h = *m.hydraulic;
       // 0 is a deliberate choice (no flow, undrained); only a positive value is checked.

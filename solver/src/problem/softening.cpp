@@ -25,9 +25,10 @@ Problem regularise_softening(const Problem& problem) {
   const double h = softening_cell_size(problem);
   for (Material& m : out.materials)
     if (auto* mc = std::get_if<MohrCoulomb>(&m.plasticity))
-      if (mc->softening && mc->softening->reference_cell_size > 0.0) {
+      if (mc->softening && mc->softening->reference_cell_size > 0.0 &&
+          !mc->softening->regularised) {
         mc->softening->shape_factor *= h / mc->softening->reference_cell_size;
-        mc->softening->reference_cell_size = 0.0;  // applied
+        mc->softening->regularised = true;
       }
   return out;
 }
