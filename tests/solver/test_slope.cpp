@@ -42,6 +42,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
+#include <optional>
 #include <vector>
 
 #include "closed_form.hpp"
@@ -61,6 +63,7 @@ struct SlopeCase {
   // (E_oed/M < (rho - rho_f)/rho_f, docs/verification.md).
   double Kf = 5e7, k = 1e-3;
   double t0 = 0.5, s = 0.1, rise = 0.245;  // pulse: starts at t0, rate s, height rise in r
+  std::optional<hmpm::MohrCoulomb::Softening> softening;  // a brittle soil
 
   double h() const { return H / cells; }
   double beta() const { return beta_deg * pi / 180; }
@@ -109,7 +112,9 @@ hmpm::Problem slope_problem(const SlopeCase& c) {
   m.density = c.rho_s;
   m.youngs_modulus = c.E;
   m.poisson_ratio = c.nu;
-  m.plasticity = hmpm::MohrCoulomb{c.phi_deg, 0.0, 0.0, 0.0};
+  hmpm::MohrCoulomb mc{c.phi_deg, 0.0, 0.0, 0.0};
+  mc.softening = c.softening;
+  m.plasticity = mc;
   hmpm::Hydraulic hy;
   hy.porosity = c.n;
   hy.hydraulic_conductivity = c.k;
@@ -286,6 +291,57 @@ TEST(Slope, FailsRunsOutAndStopsUnderAPorePressurePulse) {
   EXPECT_LT(runout, block.back());
   EXPECT_GT(runout, 0.1 * c.H);
   EXPECT_LT(std::abs(late_motion), 1e-3 * c.H);
+}
+
+// A brittle slope: the same slope, its friction softening from 30 degrees
+// to phi_r with the plastic strain (eta = 5), fails at the same r_f (the
+// peak decides the onset) but runs out further, as the basal band loses
+// strength while it slides. The block bounds it: with the residual
+// friction from the onset on (mu = sin phi_r) it would run out further
+// still. Without regularisation the band's plastic strain is its slip over
+// its width, about a cell: halving the cells softens it after half the
+// slip, so the runout follows the grid. With reference_cell_size = the
+// fine cell, the shape factor scales with the cell size and the softening
+// slip is the same on both grids. In CI: 4 and 6 cells across H on a 3 m
+// segment (about 40 s); HMPM_SLOPE_STUDY=1: 4 and 8 cells on the 6 m
+// segment of the example (4.5 min; docs/verification.md has its numbers).
+TEST(Slope, BrittleRunoutFollowsTheGridUnlessRegularised) {
+  const double end = 6.5;
+  const bool study = std::getenv("HMPM_SLOPE_STUDY") != nullptr;
+  const int coarse = 4, fine = study ? 8 : 6;
+  const double length = study ? 6.0 : 3.0;
+  const auto runout = [&](int cells, std::optional<double> phi_r, double reference) {
+    SlopeCase c;
+    c.cells = cells;
+    c.L = length;
+    if (phi_r) c.softening = hmpm::MohrCoulomb::Softening{0.0, *phi_r, 0.0, 5.0, reference};
+    const SlopeRun run = run_slope(c, end);
+    const std::size_t back = static_cast<std::size_t>(0.5 / 0.01);
+    const double late = run.mean_u.back() - run.mean_u[run.mean_u.size() - 1 - back];
+    const double onset = first_time_above(run.time, run.mean_u, 0.01 * c.H);
+    std::printf(
+        "cells %d, phi_r %s, reference %.4g: onset %.3f s, runout %.4f m, motion over the "
+        "last 0.5 s %.2g m\n",
+        cells, phi_r ? std::to_string(*phi_r).c_str() : "-", reference, onset, run.mean_u.back(),
+        late);
+    EXPECT_LT(std::abs(late), 5e-3 * c.H) << "the slide has (nearly) stopped";
+    return run.mean_u.back();
+  };
+  const double h_fine = 1.0 / fine;
+  const double plain4 = runout(coarse, std::nullopt, 0), plain8 = runout(fine, std::nullopt, 0);
+  const double brittle4 = runout(coarse, 24.0, 0), brittle8 = runout(fine, 24.0, 0);
+  const double reg4 = runout(coarse, 24.0, h_fine), reg8 = runout(fine, 24.0, h_fine);
+  const double mild8 = runout(fine, 27.0, h_fine);
+  std::printf(
+      "runout: perfectly plastic %.4f / %.4f m (%d / %d cells); phi_r 24: %.4f / %.4f "
+      "(difference %.1f %%), regularised %.4f / %.4f (difference %.1f %%); phi_r 27 "
+      "regularised, %d cells: %.4f\n",
+      plain4, plain8, coarse, fine, brittle4, brittle8, 100 * (brittle8 - brittle4) / brittle8,
+      reg4, reg8, 100 * (reg8 - reg4) / reg8, fine, mild8);
+  EXPECT_GT(mild8, 1.05 * plain8) << "a brittle soil runs out further";
+  EXPECT_GT(reg8, 1.05 * mild8) << "the more brittle, the further";
+  EXPECT_LT(std::abs(reg8 - reg4), std::abs(brittle8 - brittle4))
+      << "the regularised runout is closer between the grids";
 }
 
 }  // namespace

@@ -194,19 +194,25 @@ Eigen::Matrix3d principal_return_jacobian(const ActiveSet& active, const Elastic
 
 }  // namespace detail
 
-double return_mohr_coulomb(Voigt& stress, const Elastic& el, const MohrCoulombConstants& mc) {
-  // Cheap elastic test: with s the deviator, s1 - s3 <= 2 sqrt(J2),
-  // s1 + s3 = 2p - s2 <= 2p + sqrt(J2/3) and s1 <= p + 2 sqrt(J2/3).
+namespace detail {
+
+bool surely_elastic(const Voigt& stress, const MohrCoulombConstants& mc) {
+  // With s the deviator, s1 - s3 <= 2 sqrt(J2), s1 + s3 = 2p - s2 <=
+  // 2p + sqrt(J2/3) and s1 <= p + 2 sqrt(J2/3).
   const double p = (stress(0) + stress(1) + stress(2)) / 3.0;
   const double dx = stress(0) - p, dy = stress(1) - p, dz = stress(2) - p;
   const double j2 = 0.5 * (dx * dx + dy * dy + dz * dz) + stress(3) * stress(3) +
                     stress(4) * stress(4) + stress(5) * stress(5);
   const double q = std::sqrt(j2), q3 = std::sqrt(j2 / 3.0);
   const double two_c_cos = 2.0 * mc.cohesion * mc.cos_phi;
-  if (2.0 * q + mc.sin_phi * (2.0 * p + q3) - two_c_cos <= 0.0 &&
-      p + 2.0 * q3 <= mc.tension_cutoff) {
-    return 0.0;
-  }
+  return 2.0 * q + mc.sin_phi * (2.0 * p + q3) - two_c_cos <= 0.0 &&
+         p + 2.0 * q3 <= mc.tension_cutoff;
+}
+
+}  // namespace detail
+
+double return_mohr_coulomb(Voigt& stress, const Elastic& el, const MohrCoulombConstants& mc) {
+  if (detail::surely_elastic(stress, mc)) return 0.0;  // cheap test first
 
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig;
   eig.computeDirect(detail::to_tensor(stress));
@@ -294,45 +300,69 @@ double return_mohr_coulomb_softening(Voigt& stress, const Elastic& el,
   const double kappa_n = std::max(kappa, 0.0);
   const MohrCoulombConstants start = softened(peak, kappa_n);
   const Voigt trial_stress = stress;
-  if (return_mohr_coulomb(stress, el, start) == 0.0) {  // elastic at the step's start
+  const auto elastic = [&]() {
     if (d_alg != nullptr) *d_alg = elastic_tangent(el);
     return 0.0;
-  }
+  };
+  if (detail::surely_elastic(stress, start)) return elastic();
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig;
   eig.computeDirect(detail::to_tensor(trial_stress));
   const Eigen::Vector3d& ev = eig.eigenvalues();     // ascending
   const Eigen::Vector3d trial(ev(2), ev(1), ev(0));  // s1 >= s2 >= s3
-  const double scale = trial.cwiseAbs().maxCoeff() + peak.cohesion;
-  const double tol = 1e-13 * scale;
+  const auto inside = [&](const MohrCoulombConstants& c) {
+    return c.planes[0].normal.dot(trial) - c.planes[0].offset <= 0.0 &&
+           trial(0) <= c.tension_cutoff;
+  };
+  if (inside(start)) return elastic();  // elastic at the step's start strength
+  const double tol = 1e-13 * (trial.cwiseAbs().maxCoeff() + peak.cohesion);
   constexpr double root_two_thirds = 0.816496580927726;
-  // The principal return at softening strain k, and its softening strain.
-  const auto principal = [&](double k, Eigen::Vector3d& r) {
-    const MohrCoulombConstants c = softened(peak, k);
-    const double f = c.planes[0].normal.dot(trial) - c.planes[0].offset;
-    if (f <= 0.0 && trial(0) <= c.tension_cutoff) {
+  // The principal return with constants c, and its softening strain.
+  const auto principal_with = [&](const MohrCoulombConstants& c, Eigen::Vector3d& r) {
+    if (inside(c)) {
       r = trial;
       return 0.0;
     }
     r = detail::mohr_coulomb_principal(trial, el, c, tol);
     return root_two_thirds * detail::compliance_times(el, trial - r).norm();
   };
-  // F(k) = k - kappa_n - g(k): F(kappa_n) < 0; at the residual strength g
-  // is largest, so F(kappa_n + g_residual) >= 0 (g grows as the soil softens).
+  const auto principal = [&](double k, Eigen::Vector3d& r) {
+    return principal_with(softened(peak, k), r);
+  };
+  // F(k) = k - kappa_n - g(k), g growing with k (the soil softens), so
+  // F(kappa_n) = -g_start < 0 and, the step's start strength giving the
+  // least g, F(kappa_n + g_start) <= 0. Secant steps from these two (F is
+  // smooth and, without a snap-back at the point, increasing: 2-4 steps
+  // reach the tolerance); should one leave the bracket or stall, a
+  // bracketed Illinois iteration up to the residual's g (F >= 0 there).
   Eigen::Vector3d r;
-  const double g_start = principal(kappa_n, r);
-  double lo = kappa_n, f_lo = -g_start;
-  Eigen::Vector3d r_res;
-  const double g_res = principal(std::numeric_limits<double>::infinity(), r_res);
-  double hi = kappa_n + g_res, f_hi = hi - kappa_n - principal(hi, r);
-  double k = hi;
-  const double k_tol = 1e-14 * std::max(hi, 1.0 / std::max(peak.shape_factor, 1e-300)) + 1e-300;
-  if (f_hi > 0.0) {
+  const double g_start = principal_with(start, r);
+  // kappa to 1e-12 / eta: the strength then to 1e-12 of its drop.
+  const double k_tol =
+      std::max(1e-12 / std::max(peak.shape_factor, 1e-300), 1e-15 * (kappa_n + g_start));
+  double k_prev = kappa_n, f_prev = -g_start;
+  double k = kappa_n + g_start;
+  double fk = g_start - principal(k, r);
+  double lo = k, f_lo = fk;
+  bool converged = !(fk < -k_tol);
+  for (int it = 0; it < 8 && !converged; ++it) {
+    const double next = k - fk * (k - k_prev) / (fk - f_prev);
+    if (!(next > lo) || !std::isfinite(next)) break;
+    k_prev = k, f_prev = fk;
+    k = next;
+    fk = k - kappa_n - principal(k, r);
+    if (fk < 0.0 && k > lo) lo = k, f_lo = fk;
+    converged = std::abs(fk) <= k_tol;
+  }
+  if (!converged) {
+    double hi = kappa_n + principal(std::numeric_limits<double>::infinity(), r);
+    double f_hi = hi - kappa_n - principal(hi, r);
+    k = hi;
     // Illinois (regula falsi that halves the stale end's weight).
     int side = 0;
-    for (int it = 0; it < 100 && hi - lo > k_tol; ++it) {
+    for (int it = 0; it < 100 && f_hi > 0.0 && hi - lo > k_tol; ++it) {
       k = (lo * f_hi - hi * f_lo) / (f_hi - f_lo);
       if (!(k > lo && k < hi)) k = 0.5 * (lo + hi);
-      const double fk = k - kappa_n - principal(k, r);
+      fk = k - kappa_n - principal(k, r);
       if (fk == 0.0) break;
       if (fk < 0.0) {
         lo = k, f_lo = fk;
@@ -346,14 +376,29 @@ double return_mohr_coulomb_softening(Voigt& stress, const Elastic& el,
     }
   }
   kappa = kappa_n + principal(k, r);
-  // The stress at kappa_{n+1}'s constants (bit for bit what the tangent's
-  // return below gives, so both paths agree).
+  // The stress at kappa_{n+1}'s constants, rotated back with the trial's
+  // eigenvectors (the same code in both paths, so they agree bit for bit).
   const MohrCoulombConstants end = softened(peak, kappa);
-  stress = trial_stress;
-  if (d_alg == nullptr) return return_mohr_coulomb(stress, el, end);
+  const double plastic = principal_with(end, r) / root_two_thirds;
+  const auto rotate_back = [&]() {
+    if (r(0) == r(1) && r(1) == r(2)) {
+      stress << r(0), r(0), r(0), 0.0, 0.0, 0.0;
+    } else {
+      const Eigen::Matrix3d& v = eig.eigenvectors();
+      const Eigen::Matrix3d m = v * Eigen::Vector3d(r(2), r(1), r(0)).asDiagonal() * v.transpose();
+      stress << m(0, 0), m(1, 1), m(2, 2), 0.5 * (m(0, 1) + m(1, 0)), 0.5 * (m(1, 2) + m(2, 1)),
+          0.5 * (m(0, 2) + m(2, 0));
+    }
+  };
+  if (d_alg == nullptr) {
+    rotate_back();
+    return plastic;
+  }
   // The stress and its tangent at fixed kappa (the same return at `end`).
   Tangent d_kappa;
-  const double plastic = return_mohr_coulomb_with_tangent(stress, el, end, d_kappa);
+  stress = trial_stress;
+  return_mohr_coulomb_with_tangent(stress, el, end, d_kappa);
+  rotate_back();
   // d sigma / d kappa and d g / d kappa: central differences of the
   // principal return (the trial, hence its eigenvectors, is fixed).
   const double h = 1e-6 * std::max(kappa, 1.0 / std::max(peak.shape_factor, 1e-300));

@@ -87,6 +87,10 @@ Eigen::Vector3d mohr_coulomb_principal(const Eigen::Vector3d& trial, const Elast
                                        const MohrCoulombConstants& mc, double tol,
                                        ActiveSet* active = nullptr);
 
+/// A cheap sufficient test that `stress` lies inside the yield surface and
+/// the cut-off (from p and J2 alone, no eigen decomposition).
+bool surely_elastic(const Voigt& stress, const MohrCoulombConstants& mc);
+
 }  // namespace detail
 
 /// Precomputes the Mohr-Coulomb constants of `m` (angles in degrees, c and

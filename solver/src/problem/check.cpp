@@ -492,6 +492,15 @@ std::vector<ProblemIssue> check_problem(const Problem& problem) {
       if (!cc->preconsolidation_pressure && !(cc->overconsolidation_ratio >= 1))
         add(w / "overconsolidation_ratio", "must be >= 1");
     }
+    if (const auto* mc = std::get_if<MohrCoulomb>(&m.plasticity); mc && mc->softening) {
+      const MohrCoulomb::Softening& sf = *mc->softening;
+      if (!(sf.shape_factor > 0)) add(w / "softening" / "shape_factor", "must be > 0");
+      if (!(sf.residual_cohesion >= 0)) add(w / "softening" / "residual_cohesion", "must be >= 0");
+      if (!(sf.residual_friction_angle_deg >= 0 && sf.residual_friction_angle_deg < 90))
+        add(w / "softening" / "residual_friction_angle", "must be in [0, 90)");
+      if (!(sf.reference_cell_size >= 0))
+        add(w / "softening" / "reference_cell_size", "must be > 0 (0: not regularised)");
+    }
     if (m.hydraulic) {
       const Hydraulic& hy = *m.hydraulic;
       if (!(hy.porosity > 0 && hy.porosity < 1))
