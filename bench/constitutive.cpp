@@ -13,6 +13,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <exception>
 #include <random>
 #include <string>
 #include <vector>
@@ -40,7 +41,9 @@ struct Row {
 
 }  // namespace
 
-int main(int argc, char** argv) {
+namespace {
+
+int run(int argc, char** argv) {
   std::size_t points = 20000;
   int repeats = 50;
   for (int i = 1; i + 1 < argc; i += 2) {
@@ -113,4 +116,15 @@ int main(int argc, char** argv) {
                 static_cast<double>(plastic) / static_cast<double>(points), checksum);
   }
   return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    return run(argc, argv);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "bench_constitutive: %s\n", e.what());
+    return 1;
+  }
 }

@@ -79,14 +79,14 @@ void Simulation<Dim, Shape>::setup_materials() {
     model_.plastic = model_.plastic || model_.constants.back().model != Model::linear_elastic;
   }
   for (const Body& body : model_.problem.bodies)
-    model_.state_variables = std::max(
-        model_.state_variables,
-        state_variable_count(model_.constants[static_cast<std::size_t>(body.material)]));
+    model_.state_variables =
+        std::max(model_.state_variables,
+                 state_variable_count(model_.constants[static_cast<std::size_t>(body.material)]));
   for (const Stage& s : job_.stages)  // materials a stage gives a body
     for (const Stage::BodyMaterial& bm : s.body_materials)
-      model_.state_variables = std::max(
-          model_.state_variables,
-          state_variable_count(model_.constants[static_cast<std::size_t>(bm.material)]));
+      model_.state_variables =
+          std::max(model_.state_variables,
+                   state_variable_count(model_.constants[static_cast<std::size_t>(bm.material)]));
   for (const ProblemIssue& w : problem_warnings(job_))
     warnings_.push_back(w.where.text().append(": ").append(w.message));
   for (int a = 0; a < Dim; ++a) model_.gravity[a] = model_.problem.gravity[a];
