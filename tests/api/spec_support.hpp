@@ -1,5 +1,6 @@
 // spec_support.hpp — helpers of the tests that change a spec and look at
-// one error or warning (test_plausibility.cpp, test_hints.cpp).
+// one error or warning (test_plausibility.cpp, test_hints.cpp,
+// test_softening_spec.cpp, test_cam_clay_spec.cpp).
 #pragma once
 
 #include <cmath>
@@ -33,6 +34,20 @@ inline std::string issue_at(const nlohmann::json& spec, const std::string& path,
   for (const SpecError& e : r.errors)
     if (e.path == path) return e.message;
   return "";
+}
+
+/// Fails unless parsing `spec` gives an error at `path` whose message holds
+/// `part`; lists every error when it does not.
+inline void expect_error(const nlohmann::json& spec, const std::string& path,
+                         const std::string& part) {
+  const ParseResult r = parse_job(spec.dump());
+  bool found = false;
+  std::string all;
+  for (const SpecError& e : r.errors) {
+    found = found || (e.path == path && e.message.find(part) != std::string::npos);
+    all += "  " + e.path + ": " + e.message + "\n";
+  }
+  EXPECT_TRUE(found) << "wanted " << path << " (" << part << "), got:\n" << all;
 }
 
 /// The number right after `marker` in `message` (NaN when absent).

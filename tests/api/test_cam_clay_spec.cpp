@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "hmpm/api/job.hpp"
+#include "spec_support.hpp"
 
 namespace hmpm::api {
 namespace {
@@ -42,22 +43,7 @@ json clay_spec(const json& clay) {
   return spec;
 }
 
-std::vector<std::string> errors_of(const json& spec) {
-  const ParseResult r = parse_job(spec.dump());
-  std::vector<std::string> out;
-  for (const auto& e : r.errors) out.push_back(e.path + ": " + e.message);
-  return out;
-}
-
-void expect_error(const json& spec, const std::string& path, const std::string& part) {
-  const auto errors = errors_of(spec);
-  const bool found = std::any_of(errors.begin(), errors.end(), [&](const std::string& e) {
-    return e.rfind(path + ": ", 0) == 0 && e.find(part) != std::string::npos;
-  });
-  std::string all;
-  for (const auto& e : errors) all += "  " + e + "\n";
-  EXPECT_TRUE(found) << "wanted " << path << " (" << part << "), got:\n" << all;
-}
+using testing::expect_error;
 
 const ModifiedCamClay& cam_clay_of(const ParseResult& r) {
   static const ModifiedCamClay none;

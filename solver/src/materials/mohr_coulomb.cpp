@@ -209,6 +209,16 @@ bool surely_elastic(const Voigt& stress, const MohrCoulombConstants& mc) {
          p + 2.0 * q3 <= mc.tension_cutoff;
 }
 
+void rotate_back(const Eigen::Vector3d& r, const Eigen::Matrix3d& v, Voigt& stress) {
+  if (r(0) == r(1) && r(1) == r(2)) {
+    stress << r(0), r(0), r(0), 0.0, 0.0, 0.0;
+    return;
+  }
+  const Eigen::Matrix3d m = v * Eigen::Vector3d(r(2), r(1), r(0)).asDiagonal() * v.transpose();
+  stress << m(0, 0), m(1, 1), m(2, 2), 0.5 * (m(0, 1) + m(1, 0)), 0.5 * (m(1, 2) + m(2, 1)),
+      0.5 * (m(0, 2) + m(2, 0));
+}
+
 }  // namespace detail
 
 double return_mohr_coulomb(Voigt& stress, const Elastic& el, const MohrCoulombConstants& mc) {
@@ -224,14 +234,7 @@ double return_mohr_coulomb(Voigt& stress, const Elastic& el, const MohrCoulombCo
   const double scale = trial.cwiseAbs().maxCoeff() + mc.cohesion;
   const Eigen::Vector3d r = detail::mohr_coulomb_principal(trial, el, mc, 1e-13 * scale);
 
-  if (r(0) == r(1) && r(1) == r(2)) {
-    stress << r(0), r(0), r(0), 0.0, 0.0, 0.0;
-  } else {
-    const Eigen::Matrix3d& v = eig.eigenvectors();
-    const Eigen::Matrix3d m = v * Eigen::Vector3d(r(2), r(1), r(0)).asDiagonal() * v.transpose();
-    stress << m(0, 0), m(1, 1), m(2, 2), 0.5 * (m(0, 1) + m(1, 0)), 0.5 * (m(1, 2) + m(2, 1)),
-        0.5 * (m(0, 2) + m(2, 0));
-  }
+  detail::rotate_back(r, eig.eigenvectors(), stress);
   return detail::compliance_times(el, trial - r).norm();
 }
 
@@ -380,25 +383,15 @@ double return_mohr_coulomb_softening(Voigt& stress, const Elastic& el,
   // eigenvectors (the same code in both paths, so they agree bit for bit).
   const MohrCoulombConstants end = softened(peak, kappa);
   const double plastic = principal_with(end, r) / root_two_thirds;
-  const auto rotate_back = [&]() {
-    if (r(0) == r(1) && r(1) == r(2)) {
-      stress << r(0), r(0), r(0), 0.0, 0.0, 0.0;
-    } else {
-      const Eigen::Matrix3d& v = eig.eigenvectors();
-      const Eigen::Matrix3d m = v * Eigen::Vector3d(r(2), r(1), r(0)).asDiagonal() * v.transpose();
-      stress << m(0, 0), m(1, 1), m(2, 2), 0.5 * (m(0, 1) + m(1, 0)), 0.5 * (m(1, 2) + m(2, 1)),
-          0.5 * (m(0, 2) + m(2, 0));
-    }
-  };
   if (d_alg == nullptr) {
-    rotate_back();
+    detail::rotate_back(r, eig.eigenvectors(), stress);
     return plastic;
   }
   // The stress and its tangent at fixed kappa (the same return at `end`).
   Tangent d_kappa;
   stress = trial_stress;
   return_mohr_coulomb_with_tangent(stress, el, end, d_kappa);
-  rotate_back();
+  detail::rotate_back(r, eig.eigenvectors(), stress);
   // d sigma / d kappa and d g / d kappa: central differences of the
   // principal return (the trial, hence its eigenvectors, is fixed).
   const double h = 1e-6 * std::max(kappa, 1.0 / std::max(peak.shape_factor, 1e-300));

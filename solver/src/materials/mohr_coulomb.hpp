@@ -91,6 +91,10 @@ Eigen::Vector3d mohr_coulomb_principal(const Eigen::Vector3d& trial, const Elast
 /// the cut-off (from p and J2 alone, no eigen decomposition).
 bool surely_elastic(const Voigt& stress, const MohrCoulombConstants& mc);
 
+/// `stress` = the tensor of principal values r (descending) on the trial's
+/// eigenvectors v (columns, ascending eigenvalues); a hydrostatic r exactly.
+void rotate_back(const Eigen::Vector3d& r, const Eigen::Matrix3d& v, Voigt& stress);
+
 }  // namespace detail
 
 /// Precomputes the Mohr-Coulomb constants of `m` (angles in degrees, c and
