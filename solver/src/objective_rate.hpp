@@ -41,4 +41,47 @@ __attribute__((always_inline)) inline void rotate_jaumann(
   }
 }
 
+/// The spins of a Dim-dimensional gradient: 1 in 2D (W_xy), 3 in 3D
+/// (W_xy, W_yz, W_zx), 0 in 1D.
+template <int Dim>
+inline constexpr int spin_count = Dim == 2 ? 1 : (Dim == 3 ? 3 : 0);
+
+/// The derivative of rotate_jaumann(s, grad, 1) with respect to the
+/// gradient, for the Newton tangent of a scheme that rotates the stress by
+/// its increment's spin: the rotated stress is linear in the spins, so
+/// d s / d w (Voigt, from the stress s before the rotation) and
+/// d w / d grad(i, j) are exact. dsdw[w] is the Voigt derivative by spin w;
+/// the spin w of a gradient g is sum over (i, j) of coeff(w, i, j) g(i, j)
+/// (spin_gradient below).
+template <int Dim>
+inline void jaumann_derivatives(
+    const Eigen::Matrix<double, 6, 1>& s,
+    Eigen::Matrix<double, 6, 1> (&dsdw)[spin_count<Dim> > 0 ? spin_count<Dim> : 1]) {
+  const double xx = s[0], yy = s[1], zz = s[2], xy = s[3], yz = s[4], zx = s[5];
+  if constexpr (Dim == 2) {
+    dsdw[0] << 2.0 * xy, -2.0 * xy, 0.0, yy - xx, 0.0, 0.0;
+  } else if constexpr (Dim == 3) {
+    dsdw[0] << 2.0 * xy, -2.0 * xy, 0.0, yy - xx, -zx, yz;  // by a = W_xy
+    dsdw[1] << 0.0, 2.0 * yz, -2.0 * yz, zx, zz - yy, -xy;  // by b = W_yz
+    dsdw[2] << -2.0 * zx, 0.0, 2.0 * zx, -yz, xy, xx - zz;  // by c = W_zx
+  } else {
+    dsdw[0].setZero();
+  }
+}
+
+/// The spin w of a displacement gradient g = sum_l u_l grad_l^T by the
+/// displacement component b of a node with shape gradient gl:
+/// d w / d u_{l,b} (a = 0.5 (g01 - g10), b = 0.5 (g12 - g21), c = 0.5 (g20 - g02)).
+template <int Dim>
+inline double spin_gradient(int w, int b, const Eigen::Matrix<double, Dim, 1>& gl) {
+  if constexpr (Dim < 2) {
+    return 0.0;
+  } else {
+    const int i = w == 0 ? 0 : (w == 1 ? 1 : 2), j = w == 0 ? 1 : (w == 1 ? 2 : 0);
+    if (b == i) return 0.5 * gl[j];  // g(i, j) = u_i gl_j
+    if (b == j) return -0.5 * gl[i];
+    return 0.0;
+  }
+}
+
 }  // namespace hmpm

@@ -52,8 +52,17 @@ RunResult Simulation<Dim, Shape>::run(const RunOptions& options) {
   for (std::size_t k = 0; k < stages; ++k) {
     const StableStep step = stable_step(stage_problem(job_, k));
     total += std::max<std::int64_t>(1, step.steps);
-    if (k == 0) result.dt = step.chosen;  // the first stage's (also when resumed later)
+    if (k == 0) {  // the first stage's (also when resumed later)
+      result.dt = step.chosen;
+      const Problem& first = stage_problem(job_, 0);
+      result.dt_rule = step.follows_state ? "stable_with_state"
+                       : !step.fixed      ? "growing"
+                       : first.time.dt    ? "user"
+                                          : "stable";
+    }
   }
+  double dt_min = std::numeric_limits<double>::infinity(), dt_max = 0.0;  // steps taken
+  double shortened_dt = 0.0;  // the last step shortened to end a stage
   const double end = stage_problem(job_, stages - 1).time.end;  // the job's end
   result.scheme = scheme_name(job_.time.scheme);
   result.reports_iterations = scheme_row(job_.time.scheme).reports_iterations;
@@ -225,6 +234,8 @@ RunResult Simulation<Dim, Shape>::run(const RunOptions& options) {
     done_iterations.cutbacks = r.pod<std::int64_t>();
     done_iterations.max_nonlinear = r.pod<int>();
     r.array(done_iterations.worst_residuals, -1, "residuals");
+    dt_min = r.pod<double>();
+    dt_max = r.pod<double>();
     // The particles of the stage it was in, then their state.
     if (first_stage != stage_) enter_stage(first_stage);
     particles_.for_each_array(
@@ -301,6 +312,8 @@ RunResult Simulation<Dim, Shape>::run(const RunOptions& options) {
     w.pod(done_iterations.cutbacks);
     w.pod(done_iterations.max_nonlinear);
     w.array(done_iterations.worst_residuals);
+    w.pod(dt_min);
+    w.pod(dt_max);
     particles_.for_each_array([&](const auto& a) { w.array(a); });
     w.pod(static_cast<std::uint64_t>(model_.constraints.absorbing.size()));
     for (const AbsorbingConstraint& ab : model_.constraints.absorbing) {
@@ -376,14 +389,23 @@ RunResult Simulation<Dim, Shape>::run(const RunOptions& options) {
         break;
       }
       double t_new;
+      double chosen_dt;  // the step's length before it is fitted to the stage's end
       if (fixed) {
+        chosen_dt = dt;
         t_new = (j + 1 == steps) ? stage_end : t0 + static_cast<double>(j + 1) * dt;
       } else {
         // A step that would leave less than a hundredth of itself before
         // the stage's end is stretched to end there.
         const double h = time_scheme.next_dt(t);
+        chosen_dt = h;
         t_new = t + h >= stage_end - 0.01 * h ? stage_end : t + h;
         if (n + 1 >= total) total = n + 2;
+      }
+      if (t_new - t >= chosen_dt * (1.0 - 1e-9) || t_new < stage_end) {
+        dt_min = std::min(dt_min, chosen_dt);  // the step as chosen, not its rounding
+        dt_max = std::max(dt_max, chosen_dt);
+      } else {
+        shortened_dt = t_new - t;
       }
       // Load and boundary formulas are checked at the step's end time before
       // the step uses them (the start's was checked by the step before, or
@@ -515,6 +537,9 @@ RunResult Simulation<Dim, Shape>::run(const RunOptions& options) {
                          result.run_warnings.end());
   result.steps = n;
   result.end_time = t;
+  if (!(dt_max > 0)) dt_min = dt_max = shortened_dt;  // only shortened steps (or none)
+  result.dt_min = dt_min;
+  result.dt_max = dt_max;
   result.solve_seconds = seconds;
   result.particle_steps_per_second =
       seconds > 0 ? static_cast<double>(n) * static_cast<double>(particles_.size()) / seconds : 0.0;

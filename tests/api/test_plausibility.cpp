@@ -45,6 +45,7 @@ TEST(Plausibility, ExamplesGetOnlyTheirDocumentedWarnings) {
   const std::vector<std::pair<std::string, std::vector<std::string>>> expected = {
       {"bar-vibration", {"/materials/bar/youngs_modulus", "/materials/bar/density"}},
       {"brittle-slope", {}},  // regularised: no grid warning
+      {"cam-clay-embankment", {}},
       {"column-collapse", {"/bodies/0"}},
       {"darcy-flow", {}},
       {"embankment", {}},

@@ -308,6 +308,7 @@ TEST(Writers, SummaryNamesTheSchemeAndTheImplicitIterations) {
   run.iterations.solves = 130;
   run.iterations.cutbacks = 2;
   run.iterations.max_nonlinear = 9;
+  run.iterations.worst_residuals = {0.5, 1e-3, 1e-9};
   write_summary(dir.path() / "summary.json", "q", run, CostEstimate{}, {});
   const json s = json::parse(testing::read_text(dir.path() / "summary.json"));
   EXPECT_EQ(s["scheme"], "quasi_static");
@@ -315,7 +316,8 @@ TEST(Writers, SummaryNamesTheSchemeAndTheImplicitIterations) {
                                    {"linear", 4567},
                                    {"solves", 130},
                                    {"cutbacks", 2},
-                                   {"max_nonlinear", 9}}));
+                                   {"max_nonlinear", 9},
+                                   {"worst_residuals", {0.5, 1e-3, 1e-9}}}));
   // The explicit scheme has no iterations to report.
   RunResult plain;
   plain.status = RunStatus::successful;
@@ -352,6 +354,10 @@ TEST(RunJob, WritesEveryRequestedFileAndASummary) {
   EXPECT_EQ(summary["name"], "valid-2d");
   EXPECT_EQ(summary["cost"]["particles"], 48);
   EXPECT_EQ(summary["status"], "successful") << summary["message"];
+  // The automatic fixed step: every step but a last shortened one is dt.
+  EXPECT_EQ(summary["time_step"]["rule"], "stable");
+  EXPECT_EQ(summary["time_step"]["min"], summary["dt"]);
+  EXPECT_EQ(summary["time_step"]["max"], summary["dt"]);
   EXPECT_NE(std::find(out.files.begin(), out.files.end(), "series.json"), out.files.end());
   EXPECT_NE(std::find(out.files.begin(), out.files.end(), "snapshots.pvd"), out.files.end());
 }

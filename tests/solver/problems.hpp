@@ -73,6 +73,22 @@ inline hmpm::Material elastic(double rho, double e, double nu) {
   return m;
 }
 
+/// A dry, normally consolidated Modified Cam-Clay "clay" (OCR 1), with
+/// `e` its reference Young's modulus (the stable-step rules' stiffness).
+inline hmpm::Material cam_clay(double rho, double e, double nu, double lambda, double kappa,
+                               double m_ratio, double e0) {
+  hmpm::Material m = elastic(rho, e, nu);
+  m.name = "clay";
+  hmpm::ModifiedCamClay cc;
+  cc.lambda = lambda;
+  cc.kappa = kappa;
+  cc.critical_state_ratio = m_ratio;
+  cc.initial_void_ratio = e0;
+  cc.overconsolidation_ratio = 1.0;
+  m.plasticity = cc;
+  return m;
+}
+
 /// A linear elastic saturated material (incompressible grains, water of
 /// density 1000 kg/m^3 and bulk modulus kw).
 inline hmpm::Material saturated_elastic(double rho_s, double e, double nu, double porosity,

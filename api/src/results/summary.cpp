@@ -15,6 +15,8 @@ void write_summary(const std::filesystem::path& path, const std::string& job_nam
   o["steps"] = run.steps;
   o["end_time"] = run.end_time;  // nlohmann writes a non-finite number as null
   o["dt"] = run.dt;
+  // How the steps were chosen and their range (RunResult::dt_rule).
+  o["time_step"] = {{"rule", run.dt_rule}, {"min", run.dt_min}, {"max", run.dt_max}};
   o["scheme"] = run.scheme;
   if (run.reports_iterations) {
     const RunResult::Iterations& it = run.iterations;
@@ -22,7 +24,8 @@ void write_summary(const std::filesystem::path& path, const std::string& job_nam
                        {"linear", it.linear},
                        {"solves", it.solves},
                        {"cutbacks", it.cutbacks},
-                       {"max_nonlinear", it.max_nonlinear}};
+                       {"max_nonlinear", it.max_nonlinear},
+                       {"worst_residuals", it.worst_residuals}};
   }
   if (run.collapse.found) {
     const RunResult::Collapse& k = run.collapse;

@@ -70,6 +70,15 @@ struct StableStep {
   /// (initial = chosen), before the steps are shortened to land on output
   /// instants.
   StepGrowth plan{};
+  /// The stiffness of some material with particles changes with its state
+  /// (Modified Cam-Clay: K = (1 + e) p'/kappa) and dt is automatic: the
+  /// scheme re-evaluates the mechanical limit from the particles' state
+  /// before every step (fixed false; `chosen` and `steps` are then the
+  /// estimate at the materials' reference stiffness).
+  bool follows_state = false;
+  /// The mechanical limit over the materials whose stiffness does not change
+  /// with state (inf if none), s: what the re-evaluation starts from.
+  double steady_mechanical = 0.0;
 };
 
 /// Estimates the stable step for `problem` (automatic or user dt).
@@ -308,7 +317,16 @@ struct RunResult {
   std::vector<std::string> run_warnings;
   std::int64_t steps = 0;
   double end_time = 0.0;  ///< simulated time reached, s
-  double dt = 0.0;
+  double dt = 0.0;        ///< the first stage's first (or fixed) step, s
+  /// How the steps were chosen: "user" (time.dt), "stable" (the automatic
+  /// fixed step), "stable_with_state" (re-evaluated before every step from
+  /// the particles' stiffness, StableStep::follows_state) or "growing" (the
+  /// quasi-static scheme's own steps); of the first stage.
+  std::string dt_rule = "stable";
+  /// The shortest and longest steps taken, s (a step shortened to end a
+  /// stage exactly is not counted); 0 before any step.
+  double dt_min = 0.0;
+  double dt_max = 0.0;
   std::int64_t particles = 0;
   std::int64_t nodes = 0;
   double solve_seconds = 0.0;  ///< wall time of the time loop only (all runs, when resumed)

@@ -113,7 +113,7 @@ double update_modified_cam_clay(Voigt& stress, const Voigt& de, const ModifiedCa
   Step s{};
   s.kb = c.kappa / v;
   s.tb = (c.lambda - c.kappa) / v;
-  s.g = c.shear_factor * v * p_n / c.kappa;
+  s.g = cam_clay_step_shear_modulus(c, stress, e);
   s.m2 = c.m2;
   s.a = 6.0 * s.g / c.m2;
   s.pc_n = pc;

@@ -37,6 +37,8 @@
 // have the values from the start.
 #pragma once
 
+#include <algorithm>
+
 #include <Eigen/Core>
 
 #include "elastic.hpp"
@@ -70,6 +72,18 @@ ModifiedCamClayConstants make_modified_cam_clay(const hmpm::ModifiedCamClay& m, 
 /// or their initial values when a slot is not initialised (0), from the
 /// mean effective stress p (compression positive) of its stress.
 void cam_clay_start_state(const ModifiedCamClayConstants& c, double p, double& e, double& pc);
+
+/// The shear modulus a step from `stress` (sigma_n) with void ratio e (0:
+/// not initialised, e0) uses: G = shear_factor (1 + e) max(p'_n, floor) /
+/// kappa, fixed over the step. The deviatoric trial is s_n + 2G de, so the
+/// sensitivity of the updated stress to a deviatoric change ds of sigma_n
+/// is d_alg ds / (2G) (the quasi-static scheme's spin term).
+inline double cam_clay_step_shear_modulus(const ModifiedCamClayConstants& c, const Voigt& stress,
+                                          double e) {
+  const double p_n = std::max(-(stress(0) + stress(1) + stress(2)) / 3.0, mean_stress_floor);
+  const double v = 1.0 + (e > 0.0 ? e : c.initial_void_ratio);
+  return c.shear_factor * v * p_n / c.kappa;
+}
 
 /// One stress update. `stress` holds sigma_n (Voigt, Pa, compression
 /// negative; already rotated) on entry and sigma_{n+1} on exit; `de` is the

@@ -12,6 +12,7 @@
 #include "materials/material.hpp"
 #include "materials/varying.hpp"
 #include "particle_layout.hpp"
+#include "schemes/state_step.hpp"
 #include "schemes/time_scheme.hpp"
 
 namespace hmpm {
@@ -43,6 +44,7 @@ StableStep explicit_stable_step(const Problem& problem) {
   const double d = problem.dimension;
   s.mechanical = std::numeric_limits<double>::infinity();
   s.hydraulic = std::numeric_limits<double>::infinity();
+  s.steady_mechanical = std::numeric_limits<double>::infinity();
   const std::vector<bool> with_particles = materials_with_particles(problem);
   // Surface pressures (boundary/surface_pressures.hpp): a particle's face
   // conductance C w_i N_j adds at most 4 C / (Q V) = 8 c_h / l^2 to the
@@ -72,6 +74,10 @@ StableStep explicit_stable_step(const Problem& problem) {
     // Explicit central differences with lumped mass: omega_max <= sqrt(d) 2c/h,
     // stable for dt <= 2/omega_max = h / (c sqrt(d)).
     s.mechanical = std::min(s.mechanical, h / (c * std::sqrt(d)));
+    if (stiffness_follows_state(mc))
+      s.follows_state = true;
+    else
+      s.steady_mechanical = std::min(s.steady_mechanical, h / (c * std::sqrt(d)));
     if (m.hydraulic) {
       // Forward Euler on dp/dt = c_h lap p with lumped storage:
       // lambda_max = 4 d c_h / h^2 (plus the surface pressures' term),
@@ -87,6 +93,7 @@ StableStep explicit_stable_step(const Problem& problem) {
   s.limit = std::min(s.mechanical, s.hydraulic);
   s.chosen = problem.time.dt ? *problem.time.dt : problem.time.courant * s.limit;
   s.steps = fixed_step_count(problem.time.end - problem.time.start, s.chosen);
+  follow_state(problem, s);
   return s;
 }
 

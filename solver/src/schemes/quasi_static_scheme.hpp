@@ -36,9 +36,15 @@
 // (work-conjugate) strain-displacement matrix; plane strain takes the xx,
 // yy, xy rows and columns). Newton then converges quadratically; the
 // non-associated tangents are unsymmetric (the solvers are LU/BiCGSTAB).
-// Left out of the Jacobian: the Jaumann spin of sigma^n and the change of
-// the particle volumes (small in a step). time.implicit.elastic_tangent
-// (tests only) takes the elastic D everywhere: linear convergence.
+// The Jaumann spin of sigma^n (the start stress rotated by the increment's
+// spin) is linearised in runs with a return-mapping soil (its term
+// d(W sigma - sigma W)/du, unsymmetric): without it Newton converges only
+// linearly, at a rate of about |sigma|/K per iteration, which soft clays
+// under their own weight make 1e-2 (Cam-Clay embankment: 158 -> see
+// docs/schemes.md). Elastic runs leave it out (their symmetric factor
+// serves every iteration of a step). Left out: the change of the particle
+// volumes (small in a step). time.implicit.elastic_tangent (tests only)
+// takes the elastic D everywhere: linear convergence.
 //
 // Boundary conditions: prescribed velocity components give prescribed
 // increments (the trapezoidal integral of the velocity over the step),
@@ -731,6 +737,12 @@ class QuasiStaticScheme final : public TimeScheme {
     constitutive::Tangent d_alg;
     Eigen::Matrix<double, NC, Dim> db[N];  // tangent times the strain of node l
     const bool consistent_off = c_.model.problem.time.implicit.elastic_tangent;
+    // The spin's term where the tangent changes in the step anyway (a soil
+    // with a return mapping: the Jacobian is then factorised every
+    // iteration, and unsymmetric terms cost an LU instead of an LDL^T);
+    // elastic runs keep the symmetric system, whose factor serves every
+    // iteration of a step (the term only adds iterations there).
+    const bool geometric = Dim >= 2 && jacobian && !consistent_off && c_.model.plastic;
     for (std::size_t p = begin; p < end; ++p) {
       c_.template stencil_in_step<true, true>(p, s);
       local_dofs(s, dofs);
@@ -784,6 +796,27 @@ class QuasiStaticScheme final : public TimeScheme {
       // stiffness (lambda, G), or at plastic points the algorithmic tangent.
       const constitutive::Elastic& el = elastic_of(mc, parts.varying, p);
       const double lam = el.lambda * vol * inv_e, sh = el.shear * vol * inv_e;
+      // The Jaumann spin's term: the start stress rotated by the
+      // increment's spin is linear in it (objective_rate.hpp), and the
+      // rotation is deviatoric, so it enters the update as a change ds of
+      // the trial deviator: ds at elastic points, d_alg ds / (2G) at plastic
+      // ones (G the step's shear modulus; the trial is s_n + 2G de).
+      Mat spin_stress[spin_count<Dim> > 0 ? spin_count<Dim> : 1];
+      if (geometric) {
+        Voigt dsdw[spin_count<Dim> > 0 ? spin_count<Dim> : 1];
+        jaumann_derivatives<Dim>(parts.stress[p], dsdw);
+        double g_step = 0.0;
+        if (plastic)
+          g_step = mc.model == Model::modified_cam_clay
+                       ? constitutive::cam_clay_step_shear_modulus(
+                             mc.cam_clay, parts.stress[p],
+                             parts.internal[constitutive::ModifiedCamClayModel::void_ratio_slot][p])
+                       : elastic_of(mc, parts.varying, p).shear;
+        for (int w = 0; w < spin_count<Dim>; ++w) {
+          const Voigt ds = plastic ? Voigt(d_alg * dsdw[w] / (2.0 * g_step)) : dsdw[w];
+          spin_stress[w] = (vol * inv_e) * active_stress<Dim>(ds);
+        }
+      }
       if (plastic) {
         Eigen::Matrix<double, NC, NC> dr;
         for (int i = 0; i < NC; ++i)
@@ -807,6 +840,16 @@ class QuasiStaticScheme final : public TimeScheme {
                 a_loc(k * (Dim + 1) + a, l * (Dim + 1) + b) =
                     lam * gk[a] * gl[b] + sh * (gk[b] * gl[a] + (a == b ? gg : 0.0));
           }
+          if (geometric)
+            for (int w = 0; w < spin_count<Dim>; ++w) {
+              const Vec t = spin_stress[w] * gk;
+              for (int b = 0; b < Dim; ++b) {
+                const double cw = spin_gradient<Dim>(w, b, gl);
+                if (cw == 0.0) continue;
+                for (int a = 0; a < Dim; ++a)
+                  a_loc(k * (Dim + 1) + a, l * (Dim + 1) + b) += t[a] * cw;
+              }
+            }
           for (int a = 0; a < Dim; ++a) {
             a_loc(k * (Dim + 1) + a, l * (Dim + 1) + Dim) = sat ? -vol * gk[a] * s.w[l] : 0.0;
             a_loc(k * (Dim + 1) + Dim, l * (Dim + 1) + a) = sat ? -vol * s.w[k] * gl[a] : 0.0;

@@ -21,6 +21,7 @@
 #include "materials/material.hpp"
 #include "materials/varying.hpp"
 #include "particle_layout.hpp"
+#include "schemes/state_step.hpp"
 #include "schemes/time_scheme.hpp"
 
 namespace hmpm {
@@ -33,6 +34,7 @@ StableStep semi_implicit_stable_step(const Problem& problem) {
   const double d = problem.dimension;
   s.mechanical = std::numeric_limits<double>::infinity();
   s.hydraulic = std::numeric_limits<double>::infinity();  // no diffusion limit
+  s.steady_mechanical = std::numeric_limits<double>::infinity();
   const std::vector<bool> with_particles = materials_with_particles(problem);
   // Varying parameters at their largest: the stiffest particle's wave.
   const std::vector<Material> limiting = limiting_materials(problem);
@@ -42,10 +44,15 @@ StableStep semi_implicit_stable_step(const Problem& problem) {
     const double c = std::sqrt(mc.constrained_modulus / mc.mixture_density);
     s.wave_speed = std::max(s.wave_speed, c);
     s.mechanical = std::min(s.mechanical, h / (c * std::sqrt(d)));
+    if (stiffness_follows_state(mc))
+      s.follows_state = true;
+    else
+      s.steady_mechanical = std::min(s.steady_mechanical, h / (c * std::sqrt(d)));
   }
   s.limit = s.mechanical;
   s.chosen = problem.time.dt ? *problem.time.dt : problem.time.courant * s.limit;
   s.steps = fixed_step_count(problem.time.end - problem.time.start, s.chosen);
+  follow_state(problem, s);
   return s;
 }
 

@@ -52,6 +52,7 @@
 #include "phases/pressure_projection.hpp"
 #include "phases/reactions.hpp"
 #include "phases/stress_and_flux.hpp"
+#include "schemes/state_step.hpp"
 #include "schemes/time_scheme.hpp"
 #include "simulation.hpp"
 
@@ -86,6 +87,14 @@ class SemiImplicitScheme final : public TimeScheme {
 
   StableStep stable_step(const Problem& problem) const override {
     return semi_implicit_scheme_rules().stable_step(problem);
+  }
+
+  /// With an automatic dt and a soil whose stiffness follows its state
+  /// (StableStep::follows_state): the stable step at the particles' state
+  /// now (schemes/state_step.hpp).
+  double next_dt(double /*t*/) override {
+    return state_stable_dt(c_.model.problem, c_.model.stable, c_.model.constants, c_.particles,
+                           /*undrained=*/false);
   }
 
   void step(double t, double dt) override {
