@@ -274,6 +274,9 @@ class Simulation {
   /// Field::void_ratio or Field::preconsolidation_pressure at particle p:
   /// its Cam-Clay state variable, 0 at particles of other models.
   double cam_clay_value(std::size_t p, Field f) const;
+  /// Adds the run warning of a quasi-static run with linear shape
+  /// functions whose particles crossed cell boundaries (time_loop.hpp).
+  void report_cell_crossings(RunResult& result) const;
   /// Appends the excess pore pressure at time t to `c`
   /// (OutputRequest::consolidation): of every particle in the run when the
   /// request counts all, else of `counted` (job particle indices).
