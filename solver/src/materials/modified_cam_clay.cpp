@@ -64,7 +64,9 @@ double volumetric_root(const Step& s, double dphi, double x0) {
     if (!(next >= lo && next <= hi)) next = 0.5 * (lo + hi);
     const double step = std::abs(next - x);
     x = next;
-    if (step <= 1e-16 * std::abs(x) || hi - lo <= 1e-16 * std::abs(x)) break;
+    // A step of a few ulps: converged (a 1e-16 bound would wait for
+    // the bracket to close at round-off, up to the loop's 100 turns).
+    if (step <= 1e-15 * std::abs(x) || hi - lo <= 1e-15 * std::abs(x)) break;
   }
   return x;
 }
