@@ -63,8 +63,9 @@ double state_mechanical_limit(const ParticleState<Dim>& particles,
     if (!stiffness_follows_state(mc)) continue;
     const auto& s = particles.stress[p];
     const double mean = -(s[0] + s[1] + s[2]) / 3.0;  // p', compression positive
-    const double k =
-        (1.0 + e[p]) * std::max(mean, constitutive::mean_stress_floor) / mc.cam_clay.kappa;
+    // e not yet set (0) reads as e0, as the update does.
+    const double v = 1.0 + (e[p] > 0.0 ? e[p] : mc.cam_clay.initial_void_ratio);
+    const double k = v * std::max(mean, constitutive::mean_stress_floor) / mc.cam_clay.kappa;
     double modulus = k * (1.0 + 4.0 / 3.0 * mc.cam_clay.shear_factor);
     if (undrained && mc.saturated) modulus += 1.0 / mc.storage;
     stiffest = std::max(stiffest, modulus / mc.mixture_density);
