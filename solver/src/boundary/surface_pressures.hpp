@@ -97,29 +97,36 @@ inline void for_surface_particles(const std::vector<SurfacePressureLoad>& loads,
 }
 
 /// The weights w that take a particle's exchange to the nodes of its own
-/// stencil `sp` (particle p): the shape functions at the face's centre
-/// (the water crosses the face there: with the particle's own weights the
-/// linear steady profile was not a steady state, 2-11 % of q off in
-/// Terzaghi's column), on the nodes of the particle's stencil only (the
-/// nodes the particle gives storage; a face-stencil node outside it gives
-/// its share to the others), each at most 4 times the particle's own
-/// weight there (a node the particle barely reaches gets little storage
-/// from it: the cap bounds the explicit scheme's stiffness), then scaled
-/// to sum to 1.
+/// stencil `sp` (particle p, its face's centre `face`): the face's weights
+/// (face_node_weights, those of a traction: the water crosses the face
+/// there; with the particle's own weights the linear steady profile was
+/// not a steady state, 2-11 % of q off in Terzaghi's column), on the nodes
+/// of the particle's stencil only (the nodes the particle gives storage; a
+/// face node outside it gives its share to the others), each at most 4
+/// times the particle's own weight there (a node the particle barely
+/// reaches gets little storage from it: the cap bounds the explicit
+/// scheme's stiffness), then scaled to sum to 1.
 template <int Dim, class Shape>
 inline void face_weights(const shape::Stencil<Dim, Shape>& sp, const VecD<Dim>& face,
                          const GridState<Dim>& grid, const ParticleState<Dim>& particles,
                          std::size_t p, double* w) {
   using StencilT = shape::Stencil<Dim, Shape>;
+  for (int k = 0; k < StencilT::N; ++k) w[k] = 0.0;
+  int axis = 0;
+  for (int a = 1; a < Dim; ++a)
+    if (std::abs(face[a] - particles.x[p][a]) > std::abs(face[axis] - particles.x[p][axis]))
+      axis = a;
+  const double offset = face[axis] - particles.x[p][axis];
   StencilT sf;
-  sf.template compute<false>(face, grid.origin, grid.inv_h, grid.cells, grid.stride,
-                             shape::box_of(particles, p));
+  face_node_weights<Dim, Shape>(particles.x[p], axis, offset < 0.0 ? -1 : 1, 2.0 * std::abs(offset),
+                                grid, shape::box_of(particles, p), sf,
+                                [&](std::int64_t node, double wn) {
+                                  for (int k = 0; k < StencilT::N; ++k)
+                                    if (node == sp.node[k]) w[k] += wn;
+                                });
   double sum = 0.0;
   for (int k = 0; k < StencilT::N; ++k) {
-    w[k] = 0.0;
-    for (int m = 0; m < StencilT::N; ++m)
-      if (sf.node[m] == sp.node[k]) w[k] += sf.w[m];
-    w[k] = std::min(w[k], 4.0 * sp.w[k]);
+    w[k] = std::clamp(w[k], 0.0, 4.0 * sp.w[k]);
     sum += w[k];
   }
   if (!(sum > 0.0)) {  // no face node in the particle's stencil: its own weights

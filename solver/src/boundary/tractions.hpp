@@ -9,8 +9,10 @@
 #pragma once
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -117,31 +119,101 @@ std::vector<FluxLoad> compile_fluxes(const Problem& problem, const ParticleState
   return fluxes;
 }
 
+/// The weights on the nodes of a particle's face (issue 38): those that a
+/// uniform stress in the particles below the face balances exactly, so that
+/// a load q on the face and the stress -q it leads to are in equilibrium
+/// node by node (a mismatch set the whole column ringing: 11 % of q in
+/// Terzaghi's column with GIMP or B-splines at 1 particle per cell).
+/// centre: the particle's centre; axis, side: the face's outward normal;
+/// length: the particle's current length along it. Calls emit(node, w)
+/// once per node; the weights sum to 1 (inside the grid).
+///  - Linear: the hat functions at the face's centre, the divergence
+///    theorem on the cells.
+///  - GIMP: the hat functions at the face's centre too. GIMP's gradients are
+///    the particles' domain averages of the hat's, so the force of a
+///    uniform stress is the hat's flux through the body's boundary, exactly.
+///    (The particle-sized box at the face spread a quarter of its half
+///    length to the nodes on either side.)
+///  - B-spline: the point gradients do not integrate exactly, so the
+///    weights are the forces themselves: w_i = sum_j l dN_i/dn (x_j) over
+///    the particle and a column of particles of its length below it,
+///    4 cells deep (the nodes within 2 cells of the face are then fully
+///    reached; deeper ones sum to zero and are dropped), cut at the grid's
+///    edge. At 2 particles per cell this is the B-spline at the face
+///    (1/8, 3/4, 1/8); at 1 per cell it is (0, 1, 0), where the B-spline at
+///    the face put 1/8 on a node the soil does not reach.
+template <int Dim, class Shape, class Emit>
+inline void face_node_weights(const VecD<Dim>& centre, int axis, int side, double length,
+                              const GridState<Dim>& grid, shape::Box box,
+                              shape::Stencil<Dim, Shape>& s, Emit&& emit) {
+  using StencilT = shape::Stencil<Dim, Shape>;
+  VecD<Dim> at = centre;
+  at[axis] += side * 0.5 * length;
+  if constexpr (!std::is_same_v<Shape, shape::BSpline>) {
+    shape::Box point = box;
+    if (box.half_length > 0.0)
+      point = {shape::Gimp::min_half_length, 0.5 / shape::Gimp::min_half_length};
+    s.template compute<false>(at, grid.origin, grid.inv_h, grid.cells, grid.stride, point);
+    // GIMP at a face on the grid's edge: a stencil reaches a node beyond
+    // the grid, whose share goes to the nodes inside. The others' weights
+    // sum to 1 to round-off and are used as they are.
+    double sum = 0.0;
+    for (int n = 0; n < StencilT::N; ++n) sum += s.w[n];
+    const double scale = std::abs(sum - 1.0) > 1e-12 ? 1.0 / sum : 1.0;
+    for (int n = 0; n < StencilT::N; ++n) emit(s.node[n], s.w[n] * scale);
+  } else {
+    const double h = grid.h[axis];
+    const double low = grid.origin[axis], high = low + grid.cells[axis] * h;
+    const int deep = static_cast<int>(std::ceil(4.0 * h / length - 1e-9));
+    constexpr int room = StencilT::N / 3 * 16;  // 3 + 4 cells' node rows, with room
+    std::array<std::int64_t, room> node{};
+    std::array<double, room> w{};
+    int used = 0;
+    VecD<Dim> y = centre;
+    for (int j = 0; j <= deep; ++j) {
+      y[axis] = centre[axis] - side * j * length;
+      if (y[axis] <= low || y[axis] >= high) break;
+      s.template compute<true>(y, grid.origin, grid.inv_h, grid.cells, grid.stride, box);
+      for (int n = 0; n < StencilT::N; ++n) {
+        const double d = side * length * s.dw[axis][n];
+        int m = 0;
+        while (m < used && node[m] != s.node[n]) ++m;
+        if (m == used) {
+          if (used == room) continue;  // not reached: 7 node rows at most
+          node[used] = s.node[n];
+          w[used++] = 0.0;
+        }
+        w[m] += d;
+      }
+    }
+    double sum = 0.0;
+    for (int m = 0; m < used; ++m) {
+      const double depth = side * (at[axis] - grid.node_position(node[m])[axis]);
+      if (depth > 2.0 * h + 1e-9 * h) w[m] = 0.0;
+      sum += w[m];
+    }
+    if (!(std::abs(sum) > 1e-12)) return;
+    for (int m = 0; m < used; ++m)
+      if (w[m] != 0.0) emit(node[m], w[m] / sum);
+  }
+}
+
 /// Calls add(node, N area) for the nodes of the loaded face of particle k of
-/// `face`: the face lies half the particle's current length along the
-/// normal from its centre; its area follows the particle's volume, V /
-/// length0 (a follower load: the explicit schemes), or with DeadLoad keeps
-/// its initial area V0 / length0 (the quasi-static scheme).
+/// `face` (face_node_weights): the face lies half the particle's current
+/// length along the normal from its centre; its area follows the
+/// particle's volume, V / length0 (a follower load: the explicit schemes),
+/// or with DeadLoad keeps its initial area V0 / length0 (the quasi-static
+/// scheme).
 template <int Dim, class Shape, bool DeadLoad, class Add>
 inline void for_face_nodes(const FaceParticles& face, std::size_t k,
                            const ParticleState<Dim>& particles, const GridState<Dim>& grid,
                            shape::Stencil<Dim, Shape>& s, Add&& add) {
-  using StencilT = shape::Stencil<Dim, Shape>;
   const auto p = static_cast<std::size_t>(face.particles[k]);
   const double stretch = std::pow(particles.volume[p] / face.volume0[k], 1.0 / Dim);
   const double area = (DeadLoad ? face.volume0[k] : particles.volume[p]) / face.length0[k];
-  VecD<Dim> at = particles.x[p];
-  at[face.axis] += face.side * 0.5 * face.length0[k] * stretch;
-  s.template compute<false>(at, grid.origin, grid.inv_h, grid.cells, grid.stride,
-                            shape::box_of(particles, p));
-  // GIMP at a face on the grid's edge: the particle-sized stencil there
-  // reaches a node beyond the grid, whose share (half_length / 4 of the load:
-  // 6 % with 2 particles per cell) goes to the nodes inside. The other
-  // shape functions' weights sum to 1 to round-off and are used as they are.
-  double sum = 0.0;
-  for (int n = 0; n < StencilT::N; ++n) sum += s.w[n];
-  const double whole = std::abs(sum - 1.0) > 1e-12 ? area / sum : area;
-  for (int n = 0; n < StencilT::N; ++n) add(s.node[n], s.w[n] * whole);
+  face_node_weights<Dim, Shape>(particles.x[p], face.axis, face.side, face.length0[k] * stretch,
+                                grid, shape::box_of(particles, p), s,
+                                [&](std::int64_t node, double w) { add(node, w * area); });
 }
 
 /// The resultant of the surface loads at time t, N (per metre in 2D), on
