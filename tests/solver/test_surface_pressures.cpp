@@ -178,34 +178,45 @@ TEST(SurfacePressures, TerzaghiDrainedByTheSoilsOwnSurface) {
           std::printf("[ surface ] %-11s %-13s %-7s %d per cell: interior %.4f, all %.4f of q\n",
                       g.what, name(scheme), name(shape), ppc, m.interior, m.all);
           EXPECT_TRUE(m.ok) << m.message;
-          // Open (measured 3-11 % of q): the explicit scheme with GIMP and
-          // B-splines; printed above, not asserted.
-          if (scheme == hmpm::Scheme::explicit_scheme && shape != hmpm::ShapeFunction::linear)
+          // Open (measured 3.1-3.2 % explicit, 1.5 % semi-implicit): the
+          // B-spline at 2 per cell. The cause is the fixed base on the grid's
+          // edge, not the surface: the folded B-spline gives the node above
+          // the base 1/8 of a uniform stress at 2 per cell, so the column
+          // rings at rest (2.4 % of q undrained, no drainage at all). A
+          // basis linear in the edge half cells removes it (0.34 %, 0.21 %)
+          // but locks elsewhere (docs/verification.md, Known limits).
+          if (shape == hmpm::ShapeFunction::bspline && ppc == 2 &&
+              scheme != hmpm::Scheme::quasi_static)
             continue;
-          // Open (measured 0.0150 node row, 0.0153 mid cell of q in 2D):
-          // the semi-implicit scheme with B-splines at 2 per cell; printed.
-          if (scheme == hmpm::Scheme::semi_implicit && shape == hmpm::ShapeFunction::bspline &&
-              ppc == 2 && g.dim == 2)
-            continue;
-          EXPECT_LT(m.interior, 0.015)
+          // The explicit and semi-implicit schemes: the inertia number
+          // (0.2 % of q) and the grid's error (0.1-0.2 %), 0.5 % in all;
+          // the quasi-static scheme: its automatic steps' error (1.0-1.3 %
+          // measured with every shape function, the same at the grid's
+          // edge), the issue's 1.5 %.
+          const double bound = scheme == hmpm::Scheme::quasi_static ? 0.015 : 0.005;
+          EXPECT_LT(m.interior, bound)
               << g.what << " " << name(scheme) << " " << name(shape) << " " << ppc << " per cell";
         }
 }
 
-// Refinement (1D, surface on a node row, explicit, linear, 2 per cell):
-// the error falls with the cell size.
+// Refinement (1D, surface on a node row, explicit, 2 per cell, linear and
+// GIMP): the error falls with the cell size. (B-spline at 2 per cell: the
+// fixed base's ringing above, 1.1, 3.1, 1.5 % at 10, 20, 40 cells.)
 TEST(SurfacePressures, ErrorFallsUnderRefinement) {
-  double previous = 1.0;
-  for (int cells : {10, 20, 40}) {
-    Case c;
-    c.ppc = 2;
-    c.cells = cells;
-    const Measured m = measure(c);
-    std::printf("[ surface ] refinement %d cells: interior %.5f, all %.5f of q\n", cells,
-                m.interior, m.all);
-    EXPECT_TRUE(m.ok) << m.message;
-    EXPECT_LT(m.all, previous);
-    previous = m.all;
+  for (auto shape : {hmpm::ShapeFunction::linear, hmpm::ShapeFunction::gimp}) {
+    double previous = 1.0;
+    for (int cells : {10, 20, 40}) {
+      Case c;
+      c.shape = shape;
+      c.ppc = 2;
+      c.cells = cells;
+      const Measured m = measure(c);
+      std::printf("[ surface ] refinement %s %d cells: interior %.5f, all %.5f of q\n", name(shape),
+                  cells, m.interior, m.all);
+      EXPECT_TRUE(m.ok) << m.message;
+      EXPECT_LT(m.all, previous) << name(shape) << " " << cells << " cells";
+      previous = m.all;
+    }
   }
 }
 
@@ -274,40 +285,101 @@ hmpm::Problem clay_column(const Clay& c) {
   return p;
 }
 
-// Open: linear shows suction (-0.097 q) and U_s - U_p of 0.21; B-spline 0.015
-// (measured); disabled until fixed.
-TEST(SurfacePressures, DISABLED_SoftClaySettlingThroughCellsKeepsDraining) {
-  for (auto shape : {hmpm::ShapeFunction::linear, hmpm::ShapeFunction::bspline}) {
+/// The degree of consolidation of a settling clay run: the worst
+/// |U_settlement - U_pressure| while U_pressure <= 99 %, the last U from the
+/// settlement, and the least pore pressure.
+struct Settling {
+  double worst = 0, last_u = 0, min_p = 0, settlement = 0;
+};
+Settling settling(const Clay& c, const hmpm::RunResult& r) {
+  const hmpm::Series& s = r.series;
+  const std::size_t np = s.particles.size();
+  const double l0 = c.h / static_cast<double>(np);
+  const double final_settlement = c.h * (1.0 - std::exp(-c.q / c.e));
+  Settling out;
+  for (std::size_t row = 1; row < s.time.size(); ++row) {
+    double settlement = 0, mean_p = 0;
+    for (std::size_t i = 0; i < np; ++i) {
+      const double pi = s.values[0][row * np + i];
+      mean_p += pi / static_cast<double>(np);
+      out.min_p = std::min(out.min_p, pi);
+      settlement += l0 * (1.0 - std::exp(s.values[1][(row * np + i) * 6]));
+    }
+    const double u_s = settlement / final_settlement, u_p = 1.0 - mean_p / c.q;
+    if (u_p <= 0.99) out.worst = std::max(out.worst, std::abs(u_s - u_p));
+    out.last_u = u_s;
+    out.settlement = settlement;
+  }
+  return out;
+}
+
+// With GIMP and B-splines (the shape functions for soil that moves through
+// cells). Linear shape functions settle 1.5 % short here (U_s - U_p 1.2 %):
+// their particles crossing cells is an error of its own, and the run says
+// so (the crossing warning, asserted). Before the face weights balanced the
+// load (issue 38), linear showed suction (-0.097 q) and B-spline 1.5 %.
+TEST(SurfacePressures, SoftClaySettlingThroughCellsKeepsDraining) {
+  for (auto shape :
+       {hmpm::ShapeFunction::gimp, hmpm::ShapeFunction::bspline, hmpm::ShapeFunction::linear}) {
     Clay c;
     c.shape = shape;
     const hmpm::RunResult r = hmpm::run(clay_column(c));
     ASSERT_EQ(r.status, hmpm::RunStatus::successful) << r.message;
-    const hmpm::Series& s = r.series;
-    const std::size_t np = s.particles.size();
-    const double l0 = c.h / static_cast<double>(np);
-    const double final_settlement = c.h * (1.0 - std::exp(-c.q / c.e));
-    ASSERT_GT(final_settlement, 1.5 * c.h / c.cells);  // it crosses more than a cell
-    double worst = 0, min_p = 0, last_u = 0;
-    for (std::size_t row = 1; row < s.time.size(); ++row) {
-      double settlement = 0, mean_p = 0;
-      for (std::size_t i = 0; i < np; ++i) {
-        const double pi = s.values[0][row * np + i];
-        mean_p += pi / static_cast<double>(np);
-        min_p = std::min(min_p, pi);
-        settlement += l0 * (1.0 - std::exp(s.values[1][(row * np + i) * 6]));
-      }
-      const double u_s = settlement / final_settlement, u_p = 1.0 - mean_p / c.q;
-      if (u_p <= 0.99) worst = std::max(worst, std::abs(u_s - u_p));
-      last_u = u_s;
-    }
+    ASSERT_GT(c.h * (1.0 - std::exp(-c.q / c.e)), 1.5 * c.h / c.cells);  // crosses a cell and more
+    const Settling m = settling(c, r);
     std::printf(
         "[ surface ] settling clay %s: |U_settlement - U_pressure| <= %.4f to U = 99 %%, final "
         "U %.4f, min p %.5f of q\n",
-        name(shape), worst, last_u, min_p / c.q);
-    EXPECT_LT(worst, 0.01);
-    EXPECT_GT(last_u, 0.99);
-    EXPECT_LT(last_u, 1.005);
-    EXPECT_GT(min_p, -0.005 * c.q);  // no suction
+        name(shape), m.worst, m.last_u, m.min_p / c.q);
+    if (shape == hmpm::ShapeFunction::linear) {
+      bool warned = false;
+      for (const std::string& w : r.warnings) warned |= w.find("crossed") != std::string::npos;
+      EXPECT_TRUE(warned) << "linear shape functions crossing cells warn";
+      continue;
+    }
+    EXPECT_LT(m.worst, 0.01);
+    EXPECT_GT(m.last_u, 0.99);
+    EXPECT_LT(m.last_u, 1.005);
+    EXPECT_GT(m.min_p, -0.005 * c.q);  // no suction
+  }
+}
+
+// A 10 % strain (q = E_oed ln(1/0.9) = 0.105 E_oed: the top settles
+// 0.8 m, four cells of 0.2 m), GIMP, under refinement (20, 40, 80 cells):
+// the final settlement against the closed form of the hypoelastic column,
+// H (1 - exp(-q/E_oed)), and the settlement at T_v = 0.2 between grids,
+// whose differences fall.
+TEST(SurfacePressures, TenPerCentStrainConvergesUnderRefinement) {
+  double previous_gap = 1.0, previous_mid = 0.0;
+  for (int cells : {20, 40, 80}) {
+    Clay c;
+    c.shape = hmpm::ShapeFunction::gimp;
+    c.q = -c.e * std::log(0.9);  // a final log strain of ln 0.9
+    c.cells = cells;
+    hmpm::Problem p = clay_column(c);
+    p.output.series_interval = c.time_of(0.2);
+    const hmpm::RunResult r = hmpm::run(p);
+    ASSERT_EQ(r.status, hmpm::RunStatus::successful) << r.message;
+    const Settling m = settling(c, r);
+    const double exact = c.h * 0.1;
+    // The settlement at T_v = 0.2 (row 1).
+    const hmpm::Series& s = r.series;
+    const std::size_t np = s.particles.size();
+    double mid = 0;
+    for (std::size_t i = 0; i < np; ++i)
+      mid += c.h / static_cast<double>(np) * (1.0 - std::exp(s.values[1][(np + i) * 6]));
+    std::printf(
+        "[ surface ] 10 %% strain, %d cells: final settlement %.5f m (closed form %.5f), at T_v = "
+        "0.2 %.5f m, |U_s - U_p| <= %.4f, min p %.5f of q\n",
+        cells, m.settlement, exact, mid, m.worst, m.min_p / c.q);
+    EXPECT_NEAR(m.settlement, exact, 0.005 * exact);
+    EXPECT_GT(m.min_p, -0.005 * c.q);
+    if (previous_mid > 0) {
+      const double gap = std::abs(mid - previous_mid);
+      EXPECT_LT(gap, previous_gap) << cells << " cells";
+      previous_gap = gap;
+    }
+    previous_mid = mid;
   }
 }
 
