@@ -1,7 +1,8 @@
 // Drained surfaces where the ground is (issue 38, verification §13):
 // Terzaghi's consolidation (§3) with its drained top posed by
-// surface_pressures on the soil's own face, with the grid going on above
-// it: (a) the surface on a node row (1D and 2D), (b) the surface in the
+// surface_pressures on the soil's own face: (0) on the grid's edge (1D),
+// and with the grid going on above it: (a) the surface on a node row (1D
+// and 2D), (b) the surface in the
 // middle of a cell row (2D: a polygon body fills the half cell; a box
 // fills whole cells, and with one particle per cell every particle face
 // lies on a node row, so (b) has 2 particles per cell only). Every scheme
@@ -36,7 +37,7 @@ double time_of(double tv) {
   return tv * H * H / cv();
 }
 
-enum class Where { node_row, mid_cell };
+enum class Where { grid_edge, node_row, mid_cell };
 
 struct Case {
   hmpm::Scheme scheme = hmpm::Scheme::explicit_scheme;
@@ -58,11 +59,12 @@ const char* name(hmpm::Scheme s) {
 }
 
 /// The column of `c`: soil from 0 to H along the last axis, three empty
-/// cells above it, fixed and impermeable at the base, roller walls, the
+/// cells above it (none on the grid's edge), fixed and impermeable at the base, roller walls, the
 /// load q on the top row of particles and p = 0 on their top face.
 hmpm::Problem column(const Case& c) {
   const int up = c.dim - 1;
-  const double h = c.where == Where::node_row ? H / c.cells : H / (c.cells - 0.5);
+  const double h = c.where == Where::mid_cell ? H / (c.cells - 0.5) : H / c.cells;
+  const int above = c.where == Where::grid_edge ? 0 : 3;  // empty cells above the soil
   hmpm::Problem p;
   p.dimension = c.dim;
   p.shape_function = c.shape;
@@ -71,13 +73,13 @@ hmpm::Problem column(const Case& c) {
     p.grid.min[a] = 0.0;
     // Two cells across (2D): the 3-node shape functions' stencil spans
     // three node columns; a one-cell-wide grid has two (check.cpp rejects it).
-    p.grid.cells[a] = a == up ? static_cast<int>(std::ceil(H / h - 1e-9)) + 3 : 2;
+    p.grid.cells[a] = a == up ? static_cast<int>(std::ceil(H / h - 1e-9)) + above : 2;
     p.grid.max[a] = p.grid.cells[a] * h;
   }
   p.materials.push_back(problems::saturated_elastic(rho_s, E, 0.0, porosity, k, kw));
   hmpm::Body b;
   b.particles_per_cell = c.ppc;
-  if (c.where == Where::node_row) {
+  if (c.where != Where::mid_cell) {
     b.box.min = p.grid.min;
     b.box.max = p.grid.max;
     b.box.max[up] = H;
@@ -157,6 +159,7 @@ TEST(SurfacePressures, TerzaghiDrainedByTheSoilsOwnSurface) {
     const char* what;
   };
   const Geometry geometries[] = {
+      {1, Where::grid_edge, "1D grid edge"},
       {1, Where::node_row, "1D node row"},
       {2, Where::node_row, "2D node row"},
       {2, Where::mid_cell, "2D mid cell"},
