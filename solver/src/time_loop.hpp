@@ -409,7 +409,7 @@ RunResult Simulation<Dim, Shape>::run(const RunOptions& options) {
     std::int64_t j = fixed ? std::llround((t - t0) / dt) : 0;  // steps done in this stage
 
     // Plausibility of the state (run_watch.hpp): about 500 checks per stage.
-    RunWatch<Dim> watch(model_.problem, model_.constants);
+    RunWatch<Dim> watch(model_.problem, model_.constants, particles_);
     const std::int64_t watch_stride = std::max<std::int64_t>(1, steps / 500);
     std::int64_t watched = -1;  // the step count at the last check
     // A collapse the explicit and semi-implicit schemes follow
@@ -457,6 +457,9 @@ RunResult Simulation<Dim, Shape>::run(const RunOptions& options) {
         std::ostringstream where;
         if (failures_.particle >= 0) {  // -1: a failure of the run, not of a particle
           const auto p = static_cast<std::size_t>(failures_.particle);
+          // A particle that swelled (or shrank) past what soil does before it
+          // failed: that, not the grid or the step, is the likely cause.
+          failures_.hint += watch.volume_advice(particles_, p);
           where << ", particle " << (particles_.id.empty() ? failures_.particle : particles_.id[p])
                 << " at (";
           for (int a = 0; a < Dim; ++a) where << (a ? ", " : "") << number(particles_.x[p][a]);

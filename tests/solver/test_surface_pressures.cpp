@@ -407,3 +407,66 @@ TEST(SurfacePressures, NodeConditionTheSoilHasLeftStopsTheRun) {
 }
 
 }  // namespace
+
+namespace {
+
+// A pore pressure held where the soil no longer is (issue 38: a water
+// table posed on every node, "nodes": "all", keeps its pressure in space):
+// here 1.5 MPa on every node of a soft saturated column with a free top
+// (E_oed = 1 MPa), so that its effective stress becomes that pressure in
+// tension and the column swells to 2.5 times its volume and overshoots.
+// Soil does not do that; the run says so, naming the likely cause and
+// surface_pressures. With a grid too short for the swelling, the particle
+// that leaves it fails the run, and the advice names the swelling before
+// the grid's size.
+hmpm::Problem swelling_column(double grid_height) {
+  hmpm::Problem p;
+  p.dimension = 1;
+  p.grid.min[0] = 0.0;
+  p.grid.max[0] = grid_height;
+  p.grid.cells[0] = static_cast<int>(std::lround(grid_height / 0.05));
+  p.materials.push_back(problems::saturated_elastic(2650.0, 1e6, 0.0, 0.4, 1e-6, 2.2e9));
+  hmpm::Body b;
+  b.particles_per_cell = 2;
+  b.box.min = p.grid.min;
+  b.box.max = p.grid.max;
+  b.box.max[0] = 1.0;
+  p.bodies.push_back(b);
+  p.boundaries.push_back(problems::fixed_velocity(problems::plane(p, 0, 0.0), 0));
+  hmpm::NodeSelection all;
+  all.all = true;
+  p.boundaries.push_back(problems::fixed_pressure(all, 1.5e6));
+  p.local_damping = problems::constant(0.2);
+  p.time.end = 0.5;
+  return p;
+}
+
+}  // namespace
+
+TEST(SurfacePressures, APressureHeldWhereTheSoilWasSwellsItAndTheRunSaysSo) {
+  const hmpm::RunResult r = hmpm::run(swelling_column(8.0));
+  ASSERT_EQ(r.status, hmpm::RunStatus::successful) << r.message;
+  bool warned = false;
+  for (const std::string& w : r.warnings)
+    if (w.find("particle volumes outside 0.5-1.5") != std::string::npos) {
+      std::printf("[ surface ] warning: %s\n", w.c_str());
+      warned = true;
+      EXPECT_NE(w.find("surface_pressures"), std::string::npos) << w;
+      EXPECT_NE(w.find("held where the soil no longer is"), std::string::npos) << w;
+    }
+  EXPECT_TRUE(warned) << "no volume warning";
+
+  const hmpm::RunResult short_grid = hmpm::run(swelling_column(1.5));
+  ASSERT_EQ(short_grid.status, hmpm::RunStatus::failed) << short_grid.message;
+  std::printf("[ surface ] failure: %s\n", short_grid.message.c_str());
+  EXPECT_NE(short_grid.message.find("left the grid"), std::string::npos) << short_grid.message;
+  EXPECT_NE(short_grid.message.find("but first: the particle's volume is"), std::string::npos)
+      << short_grid.message;
+
+  // A consolidating column (the settling clay above) gives no such warning.
+  Clay c;
+  c.shape = hmpm::ShapeFunction::gimp;
+  const hmpm::RunResult clay = hmpm::run(clay_column(c));
+  for (const std::string& w : clay.warnings)
+    EXPECT_EQ(w.find("particle volumes outside"), std::string::npos) << w;
+}

@@ -40,9 +40,9 @@
 // spin) is linearised in runs with a return-mapping soil (its term
 // d(W sigma - sigma W)/du, unsymmetric): without it Newton converges only
 // linearly, at a rate of about |sigma|/K per iteration, which soft clays
-// under their own weight make 1e-2 (Cam-Clay embankment: 158 -> see
-// docs/schemes.md). Elastic runs leave it out (their symmetric factor
-// serves every iteration of a step). Left out: the change of the particle
+// under their own weight make 1e-2 (Cam-Clay embankment: 151 -> 132 Newton
+// iterations in all, docs/schemes.md). Elastic runs leave it out (their
+// symmetric factor serves every iteration of a step). Left out: the change of the particle
 // volumes (small in a step). time.implicit.elastic_tangent (tests only)
 // takes the elastic D everywhere: linear convergence.
 //
@@ -811,7 +811,7 @@ class QuasiStaticScheme final : public TimeScheme {
                        ? constitutive::cam_clay_step_shear_modulus(
                              mc.cam_clay, parts.stress[p],
                              parts.internal[constitutive::ModifiedCamClayModel::void_ratio_slot][p])
-                       : elastic_of(mc, parts.varying, p).shear;
+                       : el.shear;
         for (int w = 0; w < spin_count<Dim>; ++w) {
           const Voigt ds = plastic ? Voigt(d_alg * dsdw[w] / (2.0 * g_step)) : dsdw[w];
           spin_stress[w] = (vol * inv_e) * active_stress<Dim>(ds);
@@ -827,6 +827,10 @@ class QuasiStaticScheme final : public TimeScheme {
         const Vec gk = s.grad(k);
         Eigen::Matrix<double, NC, Dim> bk = Eigen::Matrix<double, NC, Dim>::Zero();
         if (plastic) bk = strain_of(gk, 1.0);
+        // The spin term's stress per node k (independent of l).
+        Vec spin_k[spin_count<Dim> > 0 ? spin_count<Dim> : 1];
+        if (geometric)
+          for (int w = 0; w < spin_count<Dim>; ++w) spin_k[w] = spin_stress[w] * gk;
         for (int l = 0; l < N; ++l) {
           const Vec gl = s.grad(l);
           const double gg = gk.dot(gl);
@@ -842,7 +846,7 @@ class QuasiStaticScheme final : public TimeScheme {
           }
           if (geometric)
             for (int w = 0; w < spin_count<Dim>; ++w) {
-              const Vec t = spin_stress[w] * gk;
+              const Vec& t = spin_k[w];
               for (int b = 0; b < Dim; ++b) {
                 const double cw = spin_gradient<Dim>(w, b, gl);
                 if (cw == 0.0) continue;
