@@ -45,6 +45,16 @@ struct Failures {
     hint = std::move(advice);
   }
 
+  /// Forgets a failure (a strength-reduction trial that lost a particle
+  /// fails as a trial, and the state goes back to the last converged one).
+  void clear() {
+    std::lock_guard<std::mutex> lock(mutex);
+    failed = false;
+    particle = -1;
+    what.clear();
+    hint.clear();
+  }
+
   /// A failure of the whole run, not of a particle (reported without one).
   void fail_run(std::string text, std::string advice) {
     std::lock_guard<std::mutex> lock(mutex);

@@ -105,7 +105,6 @@ class RunWatch {
 
   const Finding& cavitation() const { return cavitation_; }
   const Finding& tension() const { return tension_; }
-  const Finding& volume() const { return volume_; }
 
   /// Particle p's volume over its volume at the stage's start.
   double volume_ratio(const ParticleState<Dim>& ps, std::size_t p) const {

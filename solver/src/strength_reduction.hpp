@@ -14,7 +14,11 @@
 // rises by `increment`; a value that does not converge is halved back
 // towards the last converged one (a bisection) until the two are within
 // `resolution`. The failure criterion is non-convergence within
-// time.implicit.max_iterations Newton iterations: with perfectly plastic
+// strength_reduction.max_iterations Newton iterations (100 by default,
+// each with a backtracking line search: QuasiStaticScheme::backtrack), or
+// a trial that loses a particle (it leaves the grid, or its volume or a
+// value stops being finite: the state goes back to the last converged F,
+// counted in lost_particle). With perfectly plastic
 // soil, past the factor of safety no stress field within the reduced
 // strength balances gravity and the loads, so Newton's iterations cannot
 // converge, however close F is to the last converged value (Griffiths &
@@ -110,6 +114,7 @@ void Simulation<Dim, Shape>::reduce_strength(RunResult& result, double t,
       if (!varying.drucker_prager.empty()) varying.drucker_prager[p] = c.drucker_prager;
     }
   };
+  ParticleState<Dim> saved;  // the state before each trial
   double f = 1.0, step = sr.increment;
   out.factors.push_back(f);
   out.max_displacement.push_back(0.0);
@@ -126,27 +131,40 @@ void Simulation<Dim, Shape>::reduce_strength(RunResult& result, double t,
           material_constants(reduced_strength(m, next), model_.problem.gravity_constant));
     reduce_own_strength(next);
     ++out.attempts;
-    if (scheme.strength_reduce(reduced, t)) {
+    // A converged trial moves the particles: a trial that then loses one
+    // (it leaves the grid, its volume inverts) has gone past the
+    // mechanism, and the state goes back to the last converged F.
+    saved = particles_;
+    const bool converged = scheme.strength_reduce(reduced, t, sr.max_iterations);
+    if (converged) {
       f = next;
       out.factors.push_back(f);
       out.max_displacement.push_back(scheme.max_displacement());
       continue;
     }
-    if (failures_.failed) return;  // a particle failed (left the grid...): the run fails
+    if (failures_.failed) {
+      if (failures_.particle < 0) return;  // a failure of the run: it fails
+      particles_ = saved;
+      failures_.clear();
+      ++out.lost_particle;
+    }
     out.failed_at = next;
     if (next - f <= sr.resolution * (1.0 + 1e-9)) break;
     step = 0.5 * (next - f);
   }
   out.factor = f;
-  out.message = std::isnan(out.failed_at)
-                    ? "strength reduction: the soil is in equilibrium up to F = " + number(f) +
-                          " (strength_reduction.max_factor): the factor of safety is at least that"
-                    : "strength reduction: factor of safety F = " + number(f) +
-                          " (converged at F = " + number(f) +
-                          ", not at F = " + number(out.failed_at) + " within " +
-                          std::to_string(model_.problem.time.implicit.max_iterations) +
-                          " Newton iterations; largest displacement since F = 1: " +
-                          number(out.max_displacement.back()) + " m)";
+  out.message =
+      std::isnan(out.failed_at)
+          ? "strength reduction: the soil is in equilibrium up to F = " + number(f) +
+                " (strength_reduction.max_factor): the factor of safety is at least that"
+          : "strength reduction: factor of safety F = " + number(f) +
+                " (converged at F = " + number(f) + ", not at F = " + number(out.failed_at) +
+                " within " + std::to_string(sr.max_iterations) +
+                " Newton iterations (strength_reduction.max_iterations)" +
+                (out.lost_particle > 0 ? " or lost a particle" : "") +
+                "; largest displacement since F = 1: " + number(out.max_displacement.back()) +
+                " m)";
+  out.backtracks = scheme.backtracks();
   RunResult part;
   scheme.report(part);
   add_iterations(result.iterations, part.iterations);

@@ -202,6 +202,19 @@ TEST(ParseJob, DefaultsOfTheContract) {
   EXPECT_EQ(job.cost.series_rows, 0);
 }
 
+// strength_reduction.max_iterations: the trials' own Newton ceiling
+// (default 100, not time.implicit.max_iterations), range-checked at its path.
+TEST(ParseJob, StrengthReductionIterationCeiling) {
+  json spec = testing::example("slope-safety");
+  EXPECT_EQ(parse_valid(spec.dump()).problem.strength_reduction->max_iterations, 100);
+  spec["strength_reduction"]["max_iterations"] = 40;
+  EXPECT_EQ(parse_valid(spec.dump()).problem.strength_reduction->max_iterations, 40);
+  spec["strength_reduction"]["max_iterations"] = 0;
+  testing::expect_error(spec, "/strength_reduction/max_iterations", "an integer in [1, 1000]");
+  spec["strength_reduction"]["max_iterations"] = 2.5;
+  testing::expect_error(spec, "/strength_reduction/max_iterations", "integer");
+}
+
 TEST(ParseJob, LocalDampingFormulaOfTime) {
   const ParsedJob job =
       parse_valid(R"json({"dimension": 1, "grid": {"min": [0], "max": [1], "cells": [10]},

@@ -6,7 +6,7 @@
 namespace hmpm::api::parse {
 namespace {
 
-constexpr std::string_view allowed[] = {"increment", "resolution", "max_factor"};
+constexpr std::string_view allowed[] = {"increment", "resolution", "max_factor", "max_iterations"};
 
 }  // namespace
 
@@ -25,6 +25,9 @@ void read_strength_reduction(ParseContext& c, const json& j, const std::string& 
   c.r.number_at(j, path, "increment", {0.0, 10.0, true, false}, sr.increment);
   c.r.number_at(j, path, "resolution", {0.0, 1.0, true, false}, sr.resolution);
   c.r.number_at(j, path, "max_factor", {1.0, 100.0, true, false}, sr.max_factor);
+  if (j.contains("max_iterations"))
+    if (auto v = c.r.integer(j["max_iterations"], path + "/max_iterations", 1, 1000))
+      sr.max_iterations = static_cast<int>(*v);
   if (sr.resolution > sr.increment) {
     c.r.error(path + "/resolution", "is " + format_number(sr.resolution) +
                                         ", above the increment " + format_number(sr.increment) +

@@ -46,6 +46,8 @@ void write_summary(const std::filesystem::path& path, const std::string& job_nam
                                {"factors", sr.factors},
                                {"max_displacement", sr.max_displacement},
                                {"attempts", sr.attempts},
+                               {"line_search_halvings", sr.backtracks},
+                               {"trials_that_lost_a_particle", sr.lost_particle},
                                {"message", sr.message}};
   }
   o["particles"] = run.particles;

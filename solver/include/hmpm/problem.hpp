@@ -459,6 +459,9 @@ struct StrengthReduction {
   double increment = 0.1;     ///< first step of F
   double resolution = 0.005;  ///< F is bracketed to within this
   double max_factor = 10.0;   ///< F is not raised above this (the result is then "at least")
+  /// Newton iterations of a trial F before it counts as not converged (each
+  /// with a line search; time.implicit.max_iterations is the time steps').
+  int max_iterations = 100;
 };
 
 /// The contract name of a scheme ("explicit", "semi_implicit", "quasi_static"):

@@ -394,6 +394,10 @@ struct RunResult {
     std::vector<double> factors;           ///< every converged F, in order
     std::vector<double> max_displacement;  ///< m, since F = 1, at each of `factors`
     std::int64_t attempts = 0;             ///< trial values of F solved (converged or not)
+    std::int64_t backtracks = 0;           ///< line-search halvings of the trials' corrections
+    /// Trials that lost a particle (it left the grid, its volume or a
+    /// value became non-finite): counted as not converged.
+    std::int64_t lost_particle = 0;
     std::string message;
   } strength_reduction;
 };

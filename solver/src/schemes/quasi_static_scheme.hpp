@@ -211,14 +211,22 @@ class QuasiStaticScheme final : public TimeScheme {
 
   /// Strength reduction: one attempt to reach equilibrium with the material
   /// constants `reduced` (kept by reference until the next call), the loads
-  /// at `load_time`. True when it converged (the particles then take the
-  /// state); false with nothing changed.
-  bool strength_reduce(const std::vector<MaterialConstants>& reduced, double load_time) {
+  /// at `load_time`, in up to `max_iterations` Newton iterations, each with
+  /// a backtracking line search (backtrack()). True when it converged (the
+  /// particles then take the state); false with nothing changed, or after
+  /// a converged state lost a particle (a failure in c_.failures; the
+  /// particles have moved: the caller puts back its copy).
+  bool strength_reduce(const std::vector<MaterialConstants>& reduced, double load_time,
+                       int max_iterations) {
     if (!reducing_) prepared_ = false;  // every pressure is held from now on
     reducing_ = true;
+    reduce_iterations_ = std::max(1, max_iterations);
     constants_ = &reduced;
     return attempt(load_time, 1.0);
   }
+
+  /// Line-search halvings of strength-reduction trials (backtrack()).
+  std::int64_t backtracks() const { return backtracks_; }
 
   /// The largest particle displacement |x - x0|, m.
   double max_displacement() const {
@@ -461,9 +469,10 @@ class QuasiStaticScheme final : public TimeScheme {
           surface_.push_back({p, cond, p_face, seepage, face});
         });
     const ImplicitControl& c = c_.model.problem.time.implicit;
-    history_.resize(static_cast<std::size_t>(c.max_iterations) + 1);  // no-op after the first
+    const int max_iterations = reducing_ ? reduce_iterations_ : c.max_iterations;
+    history_.resize(static_cast<std::size_t>(std::max(max_iterations, c.max_iterations)) + 1);
     for (int it = 0;; ++it) {
-      const bool converged = assemble(h, /*jacobian=*/it < c.max_iterations);
+      const bool converged = assemble(h, /*jacobian=*/it < max_iterations);
       history_[static_cast<std::size_t>(it)] = std::max(last_ru_, last_rp_);
       if (converged) {
         // Seepage faces: an active set. Each step starts with every face
@@ -493,16 +502,47 @@ class QuasiStaticScheme final : public TimeScheme {
         }
         return !c_.failures.failed;
       }
-      if (it >= c.max_iterations) return false;
+      if (it >= max_iterations) return false;
+      const double r0 = reducing_ ? rhs_.squaredNorm() : 0.0;
       if (!system_.solve(rhs_, x_)) return false;
       ++nonlinear_;
-      for (std::size_t i = 0; i < nodes; ++i) {
-        for (int a = 0; a < Dim; ++a) {
-          const std::int64_t d = udof_[i * Dim + a];
-          if (d >= 0) du_[i * Dim + a] += x_[d];
-        }
-        if (pdof_[i] >= 0) p_[i] += e_ref_ * x_[pdof_[i]];
+      add_correction(1.0);
+      if (reducing_) backtrack(h, r0);
+    }
+  }
+
+  /// du and p move by `s` times the Newton correction x_.
+  void add_correction(double s) {
+    for (std::size_t i = 0; i < static_cast<std::size_t>(c_.grid.count); ++i) {
+      for (int a = 0; a < Dim; ++a) {
+        const std::int64_t d = udof_[i * Dim + a];
+        if (d >= 0) du_[i * Dim + a] += s * x_[d];
       }
+      if (pdof_[i] >= 0) p_[i] += s * e_ref_ * x_[pdof_[i]];
+    }
+  }
+
+  /// Strength-reduction trials only: a backtracking line search on the
+  /// squared residual |R|^2 (r0 before the correction). While the
+  /// correction just added raises it, the correction is halved, up to
+  /// max_backtracks times (the last length is kept either way). Near the
+  /// factor of safety the points of the coming shear band switch between
+  /// elastic and plastic from one iteration to the next, and full Newton
+  /// corrections overshoot there: the residual wanders between 1e-4 and
+  /// 6e-3 without falling, and a trial F well below the mechanism's
+  /// fails (measured on the slopes of tests/api/check_strength_reduction.py
+  /// at 0.25 m cells, the slide moved 4.4 mm: F 4 % below Bishop's). Time steps keep full
+  /// corrections: the same search made gravity loading's steps stall (their cut-backs serve
+  /// instead).
+  void backtrack(double h, double r0) {
+    constexpr int max_backtracks = 6;
+    double s = 1.0;
+    for (int k = 0; k < max_backtracks; ++k) {
+      assemble(h, /*jacobian=*/false);
+      if (rhs_.squaredNorm() <= r0) return;
+      add_correction(-0.5 * s);
+      s *= 0.5;
+      ++backtracks_;
     }
   }
 
@@ -1051,7 +1091,9 @@ class QuasiStaticScheme final : public TimeScheme {
   /// reduction (strength_reduce()).
   const std::vector<MaterialConstants>* constants_ = &c_.model.constants;
   bool reducing_ = false;
-  std::int64_t crawl_ = 0;  ///< cut-backs since a step converged at its first length
+  int reduce_iterations_ = 0;    ///< Newton iterations of a strength-reduction trial
+  std::int64_t backtracks_ = 0;  ///< line-search halvings (backtrack())
+  std::int64_t crawl_ = 0;       ///< cut-backs since a step converged at its first length
   /// Per particle: plastic in the last converged step (the collapse report).
   std::vector<std::uint8_t> yielded_;
   StepGrowth growth_;
