@@ -43,6 +43,38 @@ namespace hmpm {
 /// soil's height, beyond which a dynamic run reports a collapse.
 inline constexpr double collapse_fraction = 0.1;
 
+/// The soil's height (the file comment): the extent of the particles'
+/// initial positions along `stage`'s gravity; without gravity, the
+/// smallest non-zero extent of their bounding box; +inf without particles.
+template <int Dim>
+double soil_height(const Problem& stage, const ParticleState<Dim>& ps) {
+  using Vec = VecD<Dim>;
+  double height = 0.0;
+  if (ps.size() == 0) return std::numeric_limits<double>::infinity();
+  Vec lo = ps.x0[0], hi = ps.x0[0];
+  for (const Vec& x : ps.x0) {
+    lo = lo.cwiseMin(x);
+    hi = hi.cwiseMax(x);
+  }
+  Vec g;
+  for (int a = 0; a < Dim; ++a) g[a] = stage.gravity[static_cast<std::size_t>(a)];
+  if (g.norm() > 0.0) {
+    const Vec down = g / g.norm();
+    double top = std::numeric_limits<double>::infinity(), bottom = -top;
+    for (const Vec& x : ps.x0) {
+      top = std::min(top, x.dot(down));
+      bottom = std::max(bottom, x.dot(down));
+    }
+    height = bottom - top;
+  }
+  if (!(height > 0.0)) {
+    height = std::numeric_limits<double>::infinity();
+    for (int a = 0; a < Dim; ++a)
+      if (hi[a] > lo[a]) height = std::min(height, hi[a] - lo[a]);
+  }
+  return height;
+}
+
 template <int Dim>
 class CollapseWatch {
  public:
@@ -56,27 +88,7 @@ class CollapseWatch {
                 ps.size() > 0) {
     if (!active_) return;
     plastic_ = ps.plastic_strain;
-    Vec lo = ps.x0[0], hi = ps.x0[0];
-    for (const Vec& x : ps.x0) {
-      lo = lo.cwiseMin(x);
-      hi = hi.cwiseMax(x);
-    }
-    Vec g;
-    for (int a = 0; a < Dim; ++a) g[a] = stage.gravity[static_cast<std::size_t>(a)];
-    if (g.norm() > 0.0) {
-      const Vec down = g / g.norm();
-      double top = std::numeric_limits<double>::infinity(), bottom = -top;
-      for (const Vec& x : ps.x0) {
-        top = std::min(top, x.dot(down));
-        bottom = std::max(bottom, x.dot(down));
-      }
-      height_ = bottom - top;
-    }
-    if (!(height_ > 0.0)) {
-      height_ = std::numeric_limits<double>::infinity();
-      for (int a = 0; a < Dim; ++a)
-        if (hi[a] > lo[a]) height_ = std::min(height_, hi[a] - lo[a]);
-    }
+    height_ = soil_height(stage, ps);
     active_ = std::isfinite(height_) && height_ > 0.0;
   }
 

@@ -13,19 +13,29 @@
 // prescribed displacements held, pore pressures held). F starts at 1 and
 // rises by `increment`; a value that does not converge is halved back
 // towards the last converged one (a bisection) until the two are within
-// `resolution`. The failure criterion is non-convergence within
-// strength_reduction.max_iterations Newton iterations (100 by default,
-// each with a backtracking line search: QuasiStaticScheme::backtrack), or
-// a trial that loses a particle (it leaves the grid, or its volume or a
-// value stops being finite: the state goes back to the last converged F,
-// counted in lost_particle). With perfectly plastic
-// soil, past the factor of safety no stress field within the reduced
-// strength balances gravity and the loads, so Newton's iterations cannot
-// converge, however close F is to the last converged value (Griffiths &
-// Lane 1999, Geotechnique 49(3), use the same criterion with an iteration
-// ceiling). The displacement since F = 1 is kept at every converged F: it
-// rises steeply towards F (the other criterion of the literature, shown
-// in summary.json). The mechanism (displacement and plastic strain since
+// `resolution`. A trial fails in one of three ways:
+//  - no equilibrium within strength_reduction.max_iterations Newton
+//    iterations (100 by default, each with a backtracking line search:
+//    QuasiStaticScheme::backtrack). With perfectly plastic soil, past the
+//    factor of safety no stress field within the reduced strength
+//    balances gravity and the loads (Griffiths & Lane 1999, Geotechnique
+//    49(3), use this criterion with an iteration ceiling);
+//  - equilibrium only after a slide: a particle moved further than
+//    strength_reduction.displacement_limit since F = 1 (by default 0.5 %
+//    of the soil's height, soil_height()). The updated-Lagrangian
+//    geometry of a slope that has slid 0.05-0.5 m is a new, flatter
+//    equilibrium that small-strain analysis does not have: without this,
+//    F is where no slide can reach equilibrium any more, which depends on
+//    the grid (docs/verification.md: 4 % between 1 and 0.25 m cells with
+//    psi = 0; with psi = phi trials converged after dilatant slides of
+//    metres). The displacement since F = 1 rises 10-100 fold within a
+//    few hundredths of F at the mechanism, so the limit's exact value
+//    matters little;
+//  - a converged state that loses a particle (it leaves the grid, or its
+//    volume or a value stops being finite).
+// A failed trial puts the state back to the last converged F (a copy).
+// The displacement since F = 1 is kept at every converged F. The mechanism
+// (displacement and plastic strain since
 // F = 1 at the largest converged F) is the run's last snapshot.
 #pragma once
 
@@ -35,6 +45,7 @@
 #include <variant>
 #include <vector>
 
+#include "collapse_watch.hpp"
 #include "failures.hpp"
 #include "materials/material.hpp"
 #include "schemes/quasi_static_scheme.hpp"
@@ -114,7 +125,11 @@ void Simulation<Dim, Shape>::reduce_strength(RunResult& result, double t,
       if (!varying.drucker_prager.empty()) varying.drucker_prager[p] = c.drucker_prager;
     }
   };
+  out.displacement_limit = sr.displacement_limit ? *sr.displacement_limit
+                                                 : StrengthReduction::slide_fraction *
+                                                       soil_height(model_.problem, particles_);
   ParticleState<Dim> saved;  // the state before each trial
+  std::string why;           // what failed the last failing trial
   double f = 1.0, step = sr.increment;
   out.factors.push_back(f);
   out.max_displacement.push_back(0.0);
@@ -136,17 +151,28 @@ void Simulation<Dim, Shape>::reduce_strength(RunResult& result, double t,
     // mechanism, and the state goes back to the last converged F.
     saved = particles_;
     const bool converged = scheme.strength_reduce(reduced, t, sr.max_iterations);
-    if (converged) {
+    const double moved = converged ? scheme.max_displacement() : 0.0;
+    if (converged && !(moved > out.displacement_limit)) {
       f = next;
       out.factors.push_back(f);
-      out.max_displacement.push_back(scheme.max_displacement());
+      out.max_displacement.push_back(moved);
       continue;
     }
-    if (failures_.failed) {
+    if (converged) {  // in equilibrium only after sliding further than displacement_limit
+      particles_ = saved;
+      ++out.past_displacement_limit;
+      why = "equilibrium only after a slide of " + number(moved) +
+            " m, more than strength_reduction.displacement_limit " +
+            number(out.displacement_limit) + " m";
+    } else if (failures_.failed) {
       if (failures_.particle < 0) return;  // a failure of the run: it fails
       particles_ = saved;
+      why = "its equilibrium lost a particle (" + failures_.what + ")";
       failures_.clear();
       ++out.lost_particle;
+    } else {
+      why = "no equilibrium within " + std::to_string(sr.max_iterations) +
+            " Newton iterations (strength_reduction.max_iterations)";
     }
     out.failed_at = next;
     if (next - f <= sr.resolution * (1.0 + 1e-9)) break;
@@ -158,11 +184,8 @@ void Simulation<Dim, Shape>::reduce_strength(RunResult& result, double t,
           ? "strength reduction: the soil is in equilibrium up to F = " + number(f) +
                 " (strength_reduction.max_factor): the factor of safety is at least that"
           : "strength reduction: factor of safety F = " + number(f) +
-                " (converged at F = " + number(f) + ", not at F = " + number(out.failed_at) +
-                " within " + std::to_string(sr.max_iterations) +
-                " Newton iterations (strength_reduction.max_iterations)" +
-                (out.lost_particle > 0 ? " or lost a particle" : "") +
-                "; largest displacement since F = 1: " + number(out.max_displacement.back()) +
+                " (converged at F = " + number(f) + "; at F = " + number(out.failed_at) + " " +
+                why + "; largest displacement since F = 1: " + number(out.max_displacement.back()) +
                 " m)";
   out.backtracks = scheme.backtracks();
   RunResult part;

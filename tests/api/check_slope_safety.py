@@ -8,8 +8,8 @@ The slope's run, cohesion and friction angle are read from the example
 circular slip surfaces is found by check_strength_reduction.bishop_search
 (a grid search of centres and radii, then a pattern search; 100 slices),
 and the example is run as given. Checked: F within 5 % of Bishop's
-(issue 44's acceptance; measured -0.13 % at these 0.5 m cells, +4.4 %
-at 1 m, -1.95 % at 0.25 m, docs/verification.md), the failing factor above F within
+(issue 44's acceptance; measured -1.7 % at these 0.5 m cells, -0.4 %
+at 1 m, -2.6 % at 0.25 m, docs/verification.md), the failing factor above F within
 the resolution, the displacement growing towards failure (the last
 converged factor's more than 10x the first step's) and mechanism.vtu
 written. With --figure, the mechanism: the displacement magnitude at the

@@ -215,6 +215,17 @@ TEST(ParseJob, StrengthReductionIterationCeiling) {
   testing::expect_error(spec, "/strength_reduction/max_iterations", "integer");
 }
 
+// strength_reduction.displacement_limit: unset by default (the solver then
+// takes 0.5 % of the soil's height), a positive length when given.
+TEST(ParseJob, StrengthReductionSlideLimit) {
+  json spec = testing::example("slope-safety");
+  EXPECT_FALSE(parse_valid(spec.dump()).problem.strength_reduction->displacement_limit);
+  spec["strength_reduction"]["displacement_limit"] = 0.1;
+  EXPECT_EQ(parse_valid(spec.dump()).problem.strength_reduction->displacement_limit, 0.1);
+  spec["strength_reduction"]["displacement_limit"] = 0;
+  testing::expect_error(spec, "/strength_reduction/displacement_limit", "");
+}
+
 TEST(ParseJob, LocalDampingFormulaOfTime) {
   const ParsedJob job =
       parse_valid(R"json({"dimension": 1, "grid": {"min": [0], "max": [1], "cells": [10]},

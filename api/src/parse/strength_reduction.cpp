@@ -6,7 +6,8 @@
 namespace hmpm::api::parse {
 namespace {
 
-constexpr std::string_view allowed[] = {"increment", "resolution", "max_factor", "max_iterations"};
+constexpr std::string_view allowed[] = {"increment", "resolution", "max_factor", "max_iterations",
+                                        "displacement_limit"};
 
 }  // namespace
 
@@ -28,6 +29,9 @@ void read_strength_reduction(ParseContext& c, const json& j, const std::string& 
   if (j.contains("max_iterations"))
     if (auto v = c.r.integer(j["max_iterations"], path + "/max_iterations", 1, 1000))
       sr.max_iterations = static_cast<int>(*v);
+  double limit = 0.0;
+  if (c.r.number_at(j, path, "displacement_limit", Range::positive(), limit))
+    sr.displacement_limit = limit;
   if (sr.resolution > sr.increment) {
     c.r.error(path + "/resolution", "is " + format_number(sr.resolution) +
                                         ", above the increment " + format_number(sr.increment) +

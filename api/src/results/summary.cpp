@@ -48,6 +48,8 @@ void write_summary(const std::filesystem::path& path, const std::string& job_nam
                                {"attempts", sr.attempts},
                                {"line_search_halvings", sr.backtracks},
                                {"trials_that_lost_a_particle", sr.lost_particle},
+                               {"displacement_limit", sr.displacement_limit},
+                               {"trials_past_the_displacement_limit", sr.past_displacement_limit},
                                {"message", sr.message}};
   }
   o["particles"] = run.particles;

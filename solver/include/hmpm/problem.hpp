@@ -462,6 +462,11 @@ struct StrengthReduction {
   /// Newton iterations of a trial F before it counts as not converged (each
   /// with a line search; time.implicit.max_iterations is the time steps').
   int max_iterations = 100;
+  /// m: a trial that converges only after a particle has moved further
+  /// than this since F = 1 counts as failed (the slide criterion); unset:
+  /// slide_fraction of the soil's height (collapse_watch.hpp soil_height).
+  std::optional<double> displacement_limit;
+  static constexpr double slide_fraction = 0.005;
 };
 
 /// The contract name of a scheme ("explicit", "semi_implicit", "quasi_static"):

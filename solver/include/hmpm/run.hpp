@@ -398,6 +398,10 @@ struct RunResult {
     /// Trials that lost a particle (it left the grid, its volume or a
     /// value became non-finite): counted as not converged.
     std::int64_t lost_particle = 0;
+    /// The slide criterion in force, m (StrengthReduction::displacement_limit),
+    /// and the trials that converged only past it.
+    double displacement_limit = 0.0;
+    std::int64_t past_displacement_limit = 0;
     std::string message;
   } strength_reduction;
 };
