@@ -28,9 +28,8 @@
 //    F is where no slide can reach equilibrium any more, which depends on
 //    the grid (docs/verification.md: 4 % between 1 and 0.25 m cells with
 //    psi = 0; with psi = phi trials converged after dilatant slides of
-//    metres). The displacement since F = 1 rises 10-100 fold within a
-//    few hundredths of F at the mechanism, so the limit's exact value
-//    matters little;
+//    metres). F moves by about 1 % per doubling of the limit (measured
+//    with psi = phi at 0.5 m cells: 25, 49 and 100 mm);
 //  - a converged state that loses a particle (it leaves the grid, or its
 //    volume or a value stops being finite).
 // A failed trial puts the state back to the last converged F (a copy).
